@@ -1,0 +1,54 @@
+"""The modal analysis of a scene as a JSON-ready report (what ``fenics-drill modal`` writes)."""
+
+from __future__ import annotations
+
+from fenics_drill.discretization import BeamDiscretization
+from fenics_drill.forms import FIELD_NAMES
+from fenics_drill.modal import ModalBasis, solve_modes
+from fenics_drill.reduction import family_counts, select_modes
+from fenics_drill.scene import beam_properties
+
+
+def scene_discretization(scene: dict) -> BeamDiscretization:
+    """The beam discretization a scene asks for."""
+    beam = scene["beam"]
+    return BeamDiscretization(
+        beam_properties(scene), beam["elements"], beam["element_degree"], scene["model"]["supports"]
+    )
+
+
+def scene_modes(scene: dict) -> tuple[BeamDiscretization, ModalBasis, list[int]]:
+    """Discretization, all modes in the band of analysis, and the indices the reduction keeps."""
+    disc = scene_discretization(scene)
+    basis = solve_modes(disc, scene["modal"]["f_star_max"])
+    p = disc.properties
+    kept = select_modes(basis, scene["reduction"], p.length, p.longitudinal_wave_speed)
+    return disc, basis, [int(i) for i in kept]
+
+
+def modal_report(scene: dict) -> dict:
+    """full_dofs, every mode (frequency_hz, f_star, kind, energy fractions) and the reduced basis."""
+    disc, basis, kept = scene_modes(scene)
+    modes = [
+        {
+            "frequency_hz": float(f),
+            "f_star": float(fs),
+            "kind": kind,
+            "energy_fractions": dict(zip(FIELD_NAMES, map(float, fr))),
+        }
+        for f, fs, kind, fr in zip(basis.frequencies_hz, basis.f_star, basis.kinds, basis.energy_fractions)
+    ]
+    return {
+        "full_dofs": disc.ndofs,
+        "element_degree": disc.element_degree,
+        "elements": disc.elements,
+        "supports": disc.supports,
+        "longitudinal_wave_speed": disc.properties.longitudinal_wave_speed,
+        "modes": modes,
+        "reduced_basis": {
+            "rule": scene["reduction"]["rule"],
+            "size": len(kept),
+            "counts": family_counts(basis.kinds[i] for i in kept),
+            "mode_indices": kept,
+        },
+    }

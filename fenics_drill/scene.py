@@ -1,0 +1,262 @@
+"""Scene files: a TOML document in SI units, validated before any computation.
+
+A scene is read with :func:`load_scene` (file + ``--set section.key=value``
+overrides), checked key by key against :data:`SCHEMA`, then checked for the
+relations between keys (inner radius < outer radius < borehole radius, ...).
+Every refusal is a :class:`SceneError` naming the key, the value and what is
+admissible.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+from fenics_drill.forms import BeamProperties
+
+
+class SceneError(ValueError):
+    """A scene value that cannot be used; the message names key, value and admissible set."""
+
+
+@dataclass(frozen=True)
+class Key:
+    """One scene key: its type, default, admissible set and meaning (with unit)."""
+
+    kind: type | tuple[type, ...]
+    default: Any
+    doc: str
+    check: Callable[[Any], bool] | None = None
+    admissible: str = ""
+    choices: tuple[str, ...] | None = None
+
+
+def _positive(x) -> bool:
+    return x > 0
+
+
+def _non_negative(x) -> bool:
+    return x >= 0
+
+
+def _pos(doc: str, default, kind=float) -> Key:
+    return Key(kind, default, doc, _positive, "> 0")
+
+
+def _nonneg(doc: str, default, kind=float) -> Key:
+    return Key(kind, default, doc, _non_negative, ">= 0")
+
+
+def _flag(doc: str, default: bool = True) -> Key:
+    return Key(bool, default, doc)
+
+
+def _band_or_count(doc: str) -> Key:
+    return Key(float, -1.0, doc, lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for 'not set')")
+
+
+# Defaults are the paper's nominal scene (Tables 1-3, Section 6).
+SCHEMA: dict[str, dict[str, Key]] = {
+    "beam": {
+        "length": _pos("beam length L [m]", 100.0),
+        "elements": Key(int, 500, "number of finite elements [-]", lambda n: n >= 1, ">= 1"),
+        "element_degree": Key(
+            int, 2, "polynomial degree of v, w; u and the rotations use one degree less [-]",
+            lambda k: 2 <= k <= 5, "an integer in [2, 5]",
+        ),
+        "outer_radius": _pos("outer radius R_ext [m]", 80e-3),
+        "inner_radius": _nonneg("inner radius R_int [m]", 50e-3),
+        "density": _pos("mass density rho [kg/m^3]", 7900.0),
+        "young_modulus": _pos("elastic modulus E [Pa]", 203e9),
+        "poisson_ratio": Key(float, 0.3, "Poisson ratio nu [-]", lambda x: -1.0 < x < 0.5, "in (-1, 0.5)"),
+        "shear_factor": Key(float, 6.0 / 7.0, "shear factor kappa_s [-]", lambda x: 0 < x <= 1, "in (0, 1]"),
+        "damping": _nonneg("viscous damping constant c of Eq. (38) [1/s]", 0.01),
+    },
+    "borehole": {
+        "radius": _pos("borehole radius R_bh = R_ext + gap [m]", 95e-3),
+    },
+    "environment": {
+        "gravity": _nonneg("gravitational acceleration g, along -z [m/s^2]", 9.81),
+    },
+    "contact": {
+        "stiffness_linear": _nonneg("k_FS1 of Eq. (17) [N/m]", 1e10),
+        "stiffness_cubic": _nonneg("k_FS2 of Eq. (17) [N/m^3]", 1e16),
+        "damping": _nonneg("c_FS of Eq. (17) [N s/m^4]", 1e6),
+        "friction": _nonneg("mu_FS of Eqs. (18)-(19) [-]", 0.25),
+    },
+    "bit_rock": {
+        "limit_force": _nonneg("Gamma_BR of Eq. (20) [N]", 30e3),
+        "rate": _nonneg("alpha_BR of Eq. (20) [s/m]", 400.0),
+        "friction": Key(float, 0.4, "mu_BR of Eq. (21) [-]", lambda x: 0 <= x <= 1, "in [0, 1]"),
+    },
+    "drive": {
+        "axial_velocity": Key(float, 1.0 / 180.0, "V0, imposed axial velocity at x = 0 [m/s]"),
+        "rotation_speed": Key(float, 2.0 * math.pi, "Omega, imposed rotation speed at x = 0 [rad/s]"),
+    },
+    "time": {
+        "t_end": _pos("end of the simulated interval [s]", 10.0),
+    },
+    "model": {
+        "supports": Key(
+            str, "paper",
+            "'paper': v, w, theta_y, theta_z fixed at x=0 and v, w at x=L; "
+            "'pinned': v, w fixed at both ends",
+            choices=("paper", "pinned"),
+        ),
+        "gravity": _flag("assemble the gravity load (52)"),
+        "contact": _flag("evaluate wall impacts (16)-(19)"),
+        "bit_rock": _flag("evaluate the bit-rock force and torque (20)-(22)"),
+        "geometric_nonlinearity": _flag("assemble the geometric nonlinear force F_SE (49)"),
+        "inertial_nonlinearity": _flag("assemble the inertial nonlinear force F_KE (48)"),
+    },
+    "modal": {
+        "f_star_max": _pos("upper end of the dimensionless band of analysis B = [0, f*_max], Eq. (95) [-]", 4.0),
+    },
+    "reduction": {
+        "rule": Key(
+            str, "paper",
+            "'paper' (Section 6.3), 'band' (f* upper bounds per family), "
+            "'count' (number of modes per family) or 'none' (full order)",
+            choices=("paper", "band", "count", "none"),
+        ),
+        "flexural": _band_or_count("flexural f* upper bound ('band') or mode count ('count')"),
+        "torsional": _band_or_count("torsional f* upper bound ('band') or mode count ('count')"),
+        "axial": _band_or_count("axial f* upper bound ('band') or mode count ('count')"),
+    },
+}
+
+
+def default_scene() -> dict[str, dict[str, Any]]:
+    """The nominal scene of the paper as a nested dict."""
+    return {sec: {k: copy.deepcopy(spec.default) for k, spec in keys.items()} for sec, keys in SCHEMA.items()}
+
+
+def _describe_kind(kind) -> str:
+    kinds = kind if isinstance(kind, tuple) else (kind,)
+    names = {float: "a number", int: "an integer", bool: "true or false", str: "a string", list: "an array"}
+    return " or ".join(names.get(k, k.__name__) for k in kinds)
+
+
+def _coerce(name: str, value: Any, spec: Key) -> Any:
+    """Return ``value`` converted to the key's type, or raise SceneError."""
+    bad = SceneError(f"{name} = {value!r} is not admissible: expected {_describe_kind(spec.kind)}")
+    if spec.kind is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise bad
+        value = float(value)
+        if not math.isfinite(value):
+            raise SceneError(f"{name} = {value!r} is not admissible: expected a finite number")
+    elif spec.kind is int:
+        if isinstance(value, bool):
+            raise bad
+        if isinstance(value, float) and value.is_integer():
+            value = int(value)
+        if not isinstance(value, int):
+            raise bad
+    elif not isinstance(value, spec.kind):
+        raise bad
+    if spec.choices is not None and value not in spec.choices:
+        raise SceneError(f"{name} = {value!r} is not admissible: expected one of {', '.join(spec.choices)}")
+    if spec.check is not None and not spec.check(value):
+        raise SceneError(f"{name} = {value!r} is not admissible: must be {spec.admissible}")
+    return value
+
+
+def _check_relations(scene: dict[str, dict[str, Any]]) -> None:
+    beam, hole = scene["beam"], scene["borehole"]
+    if beam["inner_radius"] >= beam["outer_radius"]:
+        raise SceneError(
+            f"beam.inner_radius = {beam['inner_radius']!r} is not admissible: "
+            f"must be < beam.outer_radius = {beam['outer_radius']!r}"
+        )
+    if hole["radius"] <= beam["outer_radius"]:
+        raise SceneError(
+            f"borehole.radius = {hole['radius']!r} is not admissible: "
+            f"must be > beam.outer_radius = {beam['outer_radius']!r} (the string must fit in the hole)"
+        )
+    red = scene["reduction"]
+    if red["rule"] in ("band", "count"):
+        for family in ("flexural", "torsional", "axial"):
+            if red[family] < 0:
+                raise SceneError(
+                    f"reduction.{family} = {red[family]!r} is not admissible: "
+                    f"reduction.rule = '{red['rule']}' needs a value >= 0 for every family"
+                )
+            if red["rule"] == "count" and not float(red[family]).is_integer():
+                raise SceneError(
+                    f"reduction.{family} = {red[family]!r} is not admissible: "
+                    "reduction.rule = 'count' needs a whole number of modes"
+                )
+
+
+def validate(raw: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """Merge ``raw`` over the defaults, checking every key; return the complete scene."""
+    scene = default_scene()
+    for section, entries in raw.items():
+        if section not in SCHEMA:
+            raise SceneError(f"unknown section [{section}]; known sections: {', '.join(SCHEMA)}")
+        if not isinstance(entries, dict):
+            raise SceneError(f"[{section}] must be a table of keys, got {entries!r}")
+        for key, value in entries.items():
+            if key not in SCHEMA[section]:
+                raise SceneError(
+                    f"unknown key {section}.{key}; known keys of [{section}]: {', '.join(SCHEMA[section])}"
+                )
+            scene[section][key] = _coerce(f"{section}.{key}", value, SCHEMA[section][key])
+    _check_relations(scene)
+    return scene
+
+
+def parse_override(text: str) -> tuple[str, str, Any]:
+    """Parse ``section.key=value``; the value is read as TOML (bare words as strings)."""
+    if "=" not in text:
+        raise SceneError(f"override {text!r} is not of the form section.key=value")
+    dotted, value_text = text.split("=", 1)
+    parts = dotted.strip().split(".")
+    if len(parts) != 2 or not all(parts):
+        raise SceneError(f"override {text!r}: the key must be section.key, got {dotted.strip()!r}")
+    try:
+        value = tomllib.loads(f"v = {value_text.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = value_text.strip()
+    return parts[0], parts[1], value
+
+
+def load_scene(path: str | Path | None = None, overrides: list[str] | tuple[str, ...] = ()) -> dict:
+    """Read a scene file (or the defaults when ``path`` is None), apply overrides, validate."""
+    raw: dict[str, Any] = {}
+    if path is not None:
+        path = Path(path)
+        if not path.is_file():
+            raise SceneError(f"scene file {str(path)!r} does not exist")
+        try:
+            raw = tomllib.loads(path.read_text())
+        except tomllib.TOMLDecodeError as err:
+            raise SceneError(f"scene file {str(path)!r} is not valid TOML: {err}") from err
+    for text in overrides:
+        section, key, value = parse_override(text)
+        raw.setdefault(section, {})
+        if not isinstance(raw[section], dict):
+            raise SceneError(f"[{section}] must be a table of keys")
+        raw[section][key] = value
+    return validate(raw)
+
+
+def beam_properties(scene: dict) -> BeamProperties:
+    """The parameter object the forms take, built from a validated scene."""
+    b = scene["beam"]
+    return BeamProperties(
+        length=b["length"],
+        outer_radius=b["outer_radius"],
+        inner_radius=b["inner_radius"],
+        density=b["density"],
+        young_modulus=b["young_modulus"],
+        poisson_ratio=b["poisson_ratio"],
+        shear_factor=b["shear_factor"],
+        damping=b["damping"],
+        gravity=scene["environment"]["gravity"] if scene["model"]["gravity"] else 0.0,
+    )

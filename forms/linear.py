@@ -1,0 +1,54 @@
+"""Linear operators of the weak equation of motion (43): Eqs. (44), (45), (46), (52).
+
+``U`` and ``psi`` are 6-component UFL objects (trial/coefficient and test
+function of the mixed space) ordered (u, v, w, theta_x, theta_y, theta_z);
+``dx`` is the interval measure of the mesh.
+"""
+
+from __future__ import annotations
+
+import ufl
+
+from .properties import BeamProperties
+
+
+def _inertia_pairing(p: BeamProperties, psi, U):
+    """rho A (psi_u u + psi_v v + psi_w w) + rho I4 (2 psi_tx tx + psi_ty ty + psi_tz tz)."""
+    s = p.section
+    rho = p.density
+    translational = psi[0] * U[0] + psi[1] * U[1] + psi[2] * U[2]
+    rotational = 2.0 * psi[3] * U[3] + psi[4] * U[4] + psi[5] * U[5]
+    return rho * s.area * translational + rho * s.I4 * rotational
+
+
+def mass_form(p: BeamProperties, psi, U, dx):
+    """Mass operator M(psi, U), Eq. (44)."""
+    return _inertia_pairing(p, psi, U) * dx
+
+
+def damping_form(p: BeamProperties, psi, U, dx):
+    """Damping operator C(psi, U) = c M(psi, U), Eq. (45), from the dissipation function (38)."""
+    return p.damping * _inertia_pairing(p, psi, U) * dx
+
+
+def stiffness_form(p: BeamProperties, psi, U, dx):
+    """Stiffness operator K(psi, U), Eq. (46).
+
+    Axial E A u'; bending E I4 theta_y', theta_z'; torsion 2 kappa_s G I4 theta_x';
+    shear kappa_s G A (theta_y + w') and (theta_z - v').
+    """
+    s = p.section
+    E, G, ks = p.young_modulus, p.shear_modulus, p.shear_factor
+    d = lambda f: f.dx(0)  # noqa: E731 - derivative along the beam axis
+    axial = E * s.area * d(psi[0]) * d(U[0])
+    bending = E * s.I4 * (d(psi[4]) * d(U[4]) + d(psi[5]) * d(U[5]))
+    torsion = 2.0 * ks * G * s.I4 * d(psi[3]) * d(U[3])
+    shear = ks * G * s.area * (
+        (psi[4] + d(psi[2])) * (U[4] + d(U[2])) + (psi[5] - d(psi[1])) * (U[5] - d(U[1]))
+    )
+    return (axial + bending + torsion + shear) * dx
+
+
+def gravity_form(p: BeamProperties, psi, dx):
+    """Gravity load F_G(psi) = -int rho A g psi_w dx, Eq. (52); gravity points along -z."""
+    return -p.density * p.section.area * p.gravity * psi[2] * dx

@@ -1,0 +1,72 @@
+"""Material and cross-section constants of the annular beam, Eqs. (3)-(10) and (27)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class SectionConstants:
+    """Moments of the annular section S_b (Eqs. 3-10), in m^2, m^4 and m^6.
+
+    ``area`` = A (3); ``I4`` = I_yy = I_zz, with I_xx = 2 I4 (4-6);
+    ``I6`` with I_yyzz = I6 and I_yyyy = I_zzzz = 3 I6 (7-8).
+    """
+
+    area: float
+    I4: float
+    I6: float
+
+
+def section_constants(outer_radius: float, inner_radius: float) -> SectionConstants:
+    """Return A, I4 and I6 of the annulus R_int <= r <= R_ext (Eqs. 3, 9, 10)."""
+    ro, ri = outer_radius, inner_radius
+    return SectionConstants(
+        area=math.pi * (ro**2 - ri**2),
+        I4=math.pi / 4.0 * (ro**4 - ri**4),
+        I6=math.pi / 24.0 * (ro**6 - ri**6),
+    )
+
+
+@dataclass(frozen=True)
+class BeamProperties:
+    """Everything the beam forms need, in SI units.
+
+    density rho [kg/m^3], young_modulus E [Pa], poisson_ratio nu [-],
+    shear_factor kappa_s [-], damping c [1/s] (the paper's "dimensionless"
+    constant of Eq. 38 multiplies rho, so it carries 1/s), gravity g [m/s^2].
+    """
+
+    length: float
+    outer_radius: float
+    inner_radius: float
+    density: float
+    young_modulus: float
+    poisson_ratio: float
+    shear_factor: float
+    damping: float
+    gravity: float
+
+    @property
+    def section(self) -> SectionConstants:
+        return section_constants(self.outer_radius, self.inner_radius)
+
+    @property
+    def shear_modulus(self) -> float:
+        """G = E / (2 (1 + nu)), Eq. (27)."""
+        return self.young_modulus / (2.0 * (1.0 + self.poisson_ratio))
+
+    @property
+    def longitudinal_wave_speed(self) -> float:
+        """c_L = sqrt(E / rho), used in the dimensionless frequency (95)."""
+        return math.sqrt(self.young_modulus / self.density)
+
+    @property
+    def torsional_wave_speed(self) -> float:
+        """sqrt(2 kappa_s G I4 / (2 rho I4)) = sqrt(kappa_s G / rho) for the model's torsion."""
+        return math.sqrt(self.shear_factor * self.shear_modulus / self.density)
+
+    @property
+    def mass_per_length(self) -> float:
+        return self.density * self.section.area
