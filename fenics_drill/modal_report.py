@@ -38,6 +38,14 @@ def modal_report(scene: dict) -> dict:
         }
         for f, fs, kind, fr in zip(basis.frequencies_hz, basis.f_star, basis.kinds, basis.energy_fractions)
     ]
+    reduced = {
+        "rule": scene["reduction"]["rule"],
+        "size": len(kept),
+        "counts": family_counts(basis.kinds[i] for i in kept),
+        "mode_indices": kept,
+    }
+    if scene["reduction"]["rule"] == "none":  # full order: the FE space itself, no modal basis
+        reduced = {"rule": "none", "size": disc.ndofs, "counts": None, "mode_indices": None}
     return {
         "full_dofs": disc.ndofs,
         "element_degree": disc.element_degree,
@@ -45,10 +53,5 @@ def modal_report(scene: dict) -> dict:
         "supports": disc.supports,
         "longitudinal_wave_speed": disc.properties.longitudinal_wave_speed,
         "modes": modes,
-        "reduced_basis": {
-            "rule": scene["reduction"]["rule"],
-            "size": len(kept),
-            "counts": family_counts(basis.kinds[i] for i in kept),
-            "mode_indices": kept,
-        },
+        "reduced_basis": reduced,
     }
