@@ -1,0 +1,116 @@
+"""Energies of the rotating beam and the forces derived from them with ``ufl.derivative``.
+
+Kinetic energy (23)-(24) with the angular velocity (13); Green-Lagrange strains
+(31)-(33) computed from the kinematics (14) as polynomials in (y, z) and the
+strain energy (30) integrated exactly over the annulus; dissipation function (38).
+
+The generalised forces follow Lagrange's equations.  With U, V, A the
+displacement, velocity and acceleration coefficients:
+
+    inertial(psi) = d/dt dT/dV [psi] - dT/dU [psi]
+                  = D_U(dT/dV[psi])[V] + D_V(dT/dV[psi])[A] - dT/dU[psi]
+    elastic(psi)  = dV/dU [psi]          damping(psi) = dD/dV [psi]
+
+and the equation of motion (43) reads inertial + damping + elastic = F_FS + F_BR + F_G.
+"""
+
+from __future__ import annotations
+
+import ufl
+
+from .properties import BeamProperties
+from .section_polynomial import SectionPolynomial
+
+#: Arguments of the strain energy density: the only ways it depends on U.
+STRAIN_SLOTS = ("theta_x", "theta_y", "theta_z", "du", "dv", "dw", "dtheta_x", "dtheta_y", "dtheta_z")
+
+
+def strain_slots(U) -> dict:
+    """theta_x, theta_y, theta_z and the axial derivatives u', v', w', theta_x', theta_y', theta_z'."""
+    d = lambda f: f.dx(0)  # noqa: E731
+    return dict(zip(STRAIN_SLOTS, (U[3], U[4], U[5], d(U[0]), d(U[1]), d(U[2]), d(U[3]), d(U[4]), d(U[5]))))
+
+
+def green_lagrange_strains(s: dict) -> tuple[SectionPolynomial, SectionPolynomial, SectionPolynomial]:
+    """(eps_xx, eps_xy, eps_xz) from the kinematics (14), Eqs. (31)-(33), as polynomials in (y, z)."""
+    S, C = ufl.sin(s["theta_x"]), ufl.cos(s["theta_x"])
+    P = SectionPolynomial
+    tx1 = s["dtheta_x"]
+    # displacement gradient of (14): d(u_x, u_y, u_z)/d(x, y, z)
+    dux_dx = P({(0, 0): s["du"], (1, 0): -s["dtheta_z"], (0, 1): s["dtheta_y"]})
+    duy_dx = P({(0, 0): s["dv"], (1, 0): -S * tx1, (0, 1): -C * tx1})
+    duz_dx = P({(0, 0): s["dw"], (1, 0): C * tx1, (0, 1): -S * tx1})
+    dux_dy, duy_dy, duz_dy = P.constant(-s["theta_z"]), P.constant(C - 1.0), P.constant(S)
+    dux_dz, duy_dz, duz_dz = P.constant(s["theta_y"]), P.constant(-S), P.constant(C - 1.0)
+    eps_xx = dux_dx + (dux_dx * dux_dx + duy_dx * duy_dx + duz_dx * duz_dx).scale(0.5)
+    eps_xy = (duy_dx + dux_dy).scale(0.5) + (dux_dx * dux_dy + duy_dx * duy_dy + duz_dx * duz_dy).scale(0.5)
+    eps_xz = (duz_dx + dux_dz).scale(0.5) + (dux_dx * dux_dz + duy_dx * duy_dz + duz_dx * duz_dz).scale(0.5)
+    return eps_xx, eps_xy, eps_xz
+
+
+def linear_strains(s: dict) -> tuple[SectionPolynomial, SectionPolynomial, SectionPolynomial]:
+    """The strains linearised about the undeformed state (what the stiffness (46) integrates)."""
+    P = SectionPolynomial
+    eps_xx = P({(0, 0): s["du"], (1, 0): -s["dtheta_z"], (0, 1): s["dtheta_y"]})
+    eps_xy = P({(0, 0): 0.5 * (s["dv"] - s["theta_z"]), (0, 1): -0.5 * s["dtheta_x"]})
+    eps_xz = P({(0, 0): 0.5 * (s["dw"] + s["theta_y"]), (1, 0): 0.5 * s["dtheta_x"]})
+    return eps_xx, eps_xy, eps_xz
+
+
+def strain_energy_density(p: BeamProperties, s: dict, geometric_nonlinearity: bool = True):
+    """Strain energy per unit length, Eq. (30): 1/2 int_S (E e_xx^2 + 4 ks G (e_xy^2 + e_xz^2)) dA."""
+    exx, exy, exz = green_lagrange_strains(s) if geometric_nonlinearity else linear_strains(s)
+    E, kG = p.young_modulus, p.shear_factor * p.shear_modulus
+    ro, ri = p.outer_radius, p.inner_radius
+    return 0.5 * (E * (exx * exx).integrate(ro, ri) + 4.0 * kG * (exy * exy + exz * exz).integrate(ro, ri))
+
+
+def angular_velocity(U, V, inertial_nonlinearity: bool = True):
+    """omega of Eq. (13) in the inertial frame (small transverse rotations); linearised if asked."""
+    if not inertial_nonlinearity:
+        return V[3], V[4], V[5]
+    S, C = ufl.sin(U[3]), ufl.cos(U[3])
+    return V[3] + V[5] * U[4], V[4] * C - V[5] * S, V[4] * S + V[5] * C
+
+
+def kinetic_energy_density(p: BeamProperties, U, V, inertial_nonlinearity: bool = True):
+    """Kinetic energy per unit length, Eq. (24): translation plus omega . J omega / 2 with the
+    section inertia tensor J = rho diag(2 I4, I4, I4) of Eq. (23)."""
+    s = p.section
+    w1, w2, w3 = angular_velocity(U, V, inertial_nonlinearity)
+    translational = 0.5 * p.density * s.area * (V[0] ** 2 + V[1] ** 2 + V[2] ** 2)
+    rotational = 0.5 * p.density * s.I4 * (2.0 * w1**2 + w2**2 + w3**2)
+    return translational + rotational
+
+
+def dissipation_density(p: BeamProperties, V):
+    """Dissipation function per unit length, Eq. (38)."""
+    s = p.section
+    return 0.5 * p.damping * p.density * (
+        s.area * (V[0] ** 2 + V[1] ** 2 + V[2] ** 2) + s.I4 * (2.0 * V[3] ** 2 + V[4] ** 2 + V[5] ** 2)
+    )
+
+
+def inertial_force(p: BeamProperties, psi, U, V, A, dx, inertial_nonlinearity: bool = True):
+    """Lagrange's d/dt dT/dV - dT/dU as a linear form in psi (= M(psi, A) - F_KE(psi), Eqs. 44, 48)."""
+    T = kinetic_energy_density(p, U, V, inertial_nonlinearity) * dx
+    momentum = ufl.derivative(T, V, psi)
+    return ufl.derivative(momentum, U, V) + ufl.derivative(momentum, V, A) - ufl.derivative(T, U, psi)
+
+
+def elastic_force(p: BeamProperties, psi, U, dx, geometric_nonlinearity: bool = True):
+    """dV/dU [psi] (= K(psi, U) - F_SE(psi), Eqs. 46, 49)."""
+    return ufl.derivative(strain_energy_density(p, strain_slots(U), geometric_nonlinearity) * dx, U, psi)
+
+
+def damping_force(p: BeamProperties, psi, V, dx):
+    """dD/dV [psi] (= C(psi, V), Eq. 45)."""
+    return ufl.derivative(dissipation_density(p, V) * dx, V, psi)
+
+
+def strain_energy_gradient_terms(p: BeamProperties, U, geometric_nonlinearity: bool = True) -> dict:
+    """dW/d(slot) for each slot of :data:`STRAIN_SLOTS`: the factors multiplying psi_tx, ...,
+    psi_tz' in dV/dU[psi] (the energy-derived counterparts of Gamma_1..Gamma_9 plus K)."""
+    slots = {name: ufl.variable(expr) for name, expr in strain_slots(U).items()}
+    W = strain_energy_density(p, slots, geometric_nonlinearity)
+    return {name: ufl.diff(W, var) for name, var in slots.items()}
