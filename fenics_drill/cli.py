@@ -53,6 +53,35 @@ def cmd_modal(args) -> int:
     return 0
 
 
+def cmd_forms(args) -> int:
+    """List the forms, print one, or check the printed operators against the energies."""
+    from fenics_drill.discretization import BeamDiscretization
+    from fenics_drill.scene import beam_properties
+
+    scene = load_scene(args.scene, args.overrides)
+    if args.action == "check":
+        from fenics_drill.form_check import compare_printed_forms
+
+        disc = BeamDiscretization(beam_properties(scene), 6, scene["beam"]["element_degree"], "paper")
+        rows = compare_printed_forms(disc)
+        for row in rows:
+            print(f"{row.term:22s} relative L2 difference {row.relative_difference:9.2e}  {row.status}")
+        return 1 if any(r.status == "UNRECORDED MISMATCH" for r in rows) else 0
+    from fenics_drill.form_catalog import form_catalog
+
+    catalog = form_catalog(BeamDiscretization(beam_properties(scene), 2, scene["beam"]["element_degree"], "paper"))
+    if args.action == "list":
+        for name, (doc, _) in catalog.items():
+            print(f"{name:16s} {doc}")
+        return 0
+    if args.name not in catalog:
+        print(f"fenics-drill: unknown form {args.name!r}; 'fenics-drill forms list' names them", file=sys.stderr)
+        return 2
+    doc, form = catalog[args.name]
+    print(f"# {args.name}: {doc}\n{form}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="fenics-drill",
@@ -65,6 +94,12 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("modal", help="modal analysis (Eq. 62) and reduced basis (Section 6.3): DIR/modes.json")
     _scene_args(p)
     p.set_defaults(func=cmd_modal)
+    p = sub.add_parser("forms", help="list/show the weak forms, or check the printed ones against the energies")
+    p.add_argument("action", choices=("list", "show", "check"))
+    p.add_argument("name", nargs="?", help="with 'show': the form to print (see 'forms list')")
+    p.add_argument("--scene", dest="scene", default=None, help="scene whose parameters the forms use")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE")
+    p.set_defaults(func=cmd_forms)
     return parser
 
 

@@ -175,3 +175,14 @@ def test_hunt_crossley_damper_dissipates_and_has_force_units():
     assert approaching * rate < 0
     # receding, the bare damper would pull towards the wall: the law clips it to zero
     assert force_laws.hunt_crossley_normal_force(delta, -rate, 0.0, 0.0, c) == 0.0
+
+
+def test_cli_forms_check_passes_and_show_prints(capsys):
+    from fenics_drill.cli import main
+
+    assert main(["forms", "check", "--set", "beam.length=3"]) == 0
+    out = capsys.readouterr().out
+    assert "Gamma_7[dtheta_x]" in out and "UNRECORDED" not in out
+    assert main(["forms", "show", "gravity"]) == 0
+    assert "dx" in capsys.readouterr().out
+    assert main(["forms", "show", "no_such_form"]) == 2
