@@ -77,8 +77,10 @@ def cmd_forms(args) -> int:
     if args.name not in catalog:
         print(f"fenics-drill: unknown form {args.name!r}; 'fenics-drill forms list' names them", file=sys.stderr)
         return 2
+    from ufl.algorithms.apply_derivatives import apply_derivatives
+
     doc, form = catalog[args.name]
-    print(f"# {args.name}: {doc}\n{form}")
+    print(f"# {args.name}: {doc}\n{apply_derivatives(form)}")
     return 0
 
 
