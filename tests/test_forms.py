@@ -38,6 +38,7 @@ def matrix(form):
 
 
 def test_section_moments_are_those_of_eqs_3_to_10(paper_properties):
+    # Both sides are closed forms of the same integrals in double precision: round-off tolerance.
     p = paper_properties
     s = p.section
     ro, ri = p.outer_radius, p.inner_radius
@@ -141,7 +142,7 @@ def test_taylor_second_order_for_the_full_residual(disc):
     for X, b in zip((U, V, A), base):
         X.x.array[:] = b
     rates = np.log2(np.array(remainders[:-1]) / np.array(remainders[1:]))
-    assert rates == pytest.approx(2.0, abs=0.1)
+    assert rates == pytest.approx(2.0, abs=0.1)  # issue 3: observed rate within 0.1 of 2
 
 
 VELOCITIES = np.concatenate([-np.logspace(-6, 1, 50), [0.0], np.logspace(-6, 1, 50)])
