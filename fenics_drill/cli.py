@@ -53,6 +53,37 @@ def cmd_modal(args) -> int:
     return 0
 
 
+def cmd_static(args) -> int:
+    """Static equilibrium under gravity with wall contact (Section 6.4): DIR/static.json, DIR/static.xdmf."""
+    from fenics_drill.drilling_run import run_static
+
+    scene = load_scene(args.scene, args.overrides)
+    report = run_static(scene, args.out)
+    print(
+        f"max sag {report['max_sag'] * 1e3:.3f} mm at x = {report['max_sag_position']:.1f} m, "
+        f"{len(report['contact_vertices'])} vertices on the wall -> {Path(args.out) / 'static.json'}"
+    )
+    return 0
+
+
+def cmd_run(args) -> int:
+    """Drilling dynamics from the static equilibrium: summary.json, timeseries.h5, fields.xdmf."""
+    from fenics_drill.drilling_run import run_scene
+
+    scene = load_scene(args.scene, args.overrides)
+    summary = run_scene(scene, args.out, progress=not args.quiet)
+    print(
+        f"{summary['status']}: {summary['message']}; t = {summary['t_end']:.4g} s in {summary['steps']} steps, "
+        f"wall {summary['wall_time_s']:.1f} s -> {Path(args.out) / 'summary.json'}"
+    )
+    if "mean_bit_velocity" in summary:
+        print(
+            f"mean bit velocity {summary['mean_bit_velocity'] * 3600:.2f} m/h, rop {summary['rop'] * 3600:.2f} m/h, "
+            f"impacts {summary['impacts_total']}, energy balance error {summary['energy']['balance_error']:.2e}"
+        )
+    return {"finished": 0, "interrupted": 130}.get(summary["status"], 1)
+
+
 def cmd_forms(args) -> int:
     """List the forms, print one, or check the printed operators against the energies."""
     from fenics_drill.discretization import BeamDiscretization
@@ -96,6 +127,13 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("modal", help="modal analysis (Eq. 62) and reduced basis (Section 6.3): DIR/modes.json")
     _scene_args(p)
     p.set_defaults(func=cmd_modal)
+    p = sub.add_parser("static", help="static equilibrium under gravity (Section 6.4): DIR/static.json")
+    _scene_args(p)
+    p.set_defaults(func=cmd_static)
+    p = sub.add_parser("run", help="drilling dynamics: DIR/summary.json, timeseries.h5, fields.xdmf")
+    _scene_args(p)
+    p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.set_defaults(func=cmd_run)
     p = sub.add_parser("forms", help="list/show the weak forms, or check the printed ones against the energies")
     p.add_argument("action", choices=("list", "show", "check"))
     p.add_argument("name", nargs="?", help="with 'show': the form to print (see 'forms list')")

@@ -56,7 +56,7 @@ class BeamDiscretization:
     @cached_property
     def field_dofs(self) -> tuple[np.ndarray, ...]:
         """For each field, the indices of its dofs in the mixed space (local numbering)."""
-        return tuple(np.asarray(self.V.sub(i).collapse()[1], dtype=np.int32) for i in range(6))
+        return tuple(np.asarray(self.V.sub(i).collapse()[1], dtype=np.int32).ravel() for i in range(6))
 
     @cached_property
     def field_of_dof(self) -> np.ndarray:
@@ -96,3 +96,21 @@ class BeamDiscretization:
             Vi, _ = self.V.sub(i).collapse()
             x[dofs] = Vi.tabulate_dof_coordinates()[:, 0]
         return x
+
+    @cached_property
+    def vertex_x(self) -> np.ndarray:
+        """x of the mesh vertices, increasing (the nodes where wall impacts act, Section 2.3)."""
+        return np.sort(self.mesh.geometry.x[:, 0])
+
+    def vertex_dofs(self, field: int) -> np.ndarray:
+        """Dofs of ``field`` at the mesh vertices, in the order of :attr:`vertex_x`."""
+        dofs = self.field_dofs[field]
+        x = self.dof_coordinates[dofs]
+        order = np.argsort(x)
+        xs = x[order]
+        right = np.clip(np.searchsorted(xs, self.vertex_x), 1, len(xs) - 1)
+        nearest = np.where(np.abs(xs[right - 1] - self.vertex_x) <= np.abs(xs[right] - self.vertex_x), right - 1, right)
+        found = dofs[order][nearest]
+        if not np.allclose(self.dof_coordinates[found], self.vertex_x, atol=1e-9 * self.properties.length):
+            raise RuntimeError(f"field {FIELD_NAMES[field]} has no dof at every vertex")
+        return found

@@ -34,10 +34,12 @@ def regularised_sign(x, velocity_scale):
 
 def wall_friction(normal_force, axial_velocity, spin_rate, friction, borehole_radius, velocity_scale):
     """Axial friction force (18) and friction torque (19) with the magnitude |F_n|:
-    F_a = -mu |F_n| sgn(u_dot), T = -mu |F_n| R_bh sgn(theta_x_dot)."""
+    F_a = -mu |F_n| sgn(u_dot), T = -mu |F_n| R_bh sgn(theta_x_dot).
+
+    Both signs are regularised on a sliding speed: u_dot and R_bh theta_x_dot."""
     magnitude = friction * np.abs(normal_force)
     force = -magnitude * regularised_sign(axial_velocity, velocity_scale)
-    torque = -magnitude * borehole_radius * regularised_sign(spin_rate, velocity_scale)
+    torque = -magnitude * borehole_radius * regularised_sign(borehole_radius * np.asarray(spin_rate), velocity_scale)
     return force, torque
 
 

@@ -31,7 +31,7 @@ def form_catalog(disc: BeamDiscretization) -> dict[str, tuple[str, object]]:
         "printed_F_KE": ("F_KE as printed, Eq. (48)", printed.printed_inertial_nonlinear_force(p, psi, U, V, A, dx)),
         "printed_F_SE": ("F_SE as printed, Eq. (49)", printed.printed_geometric_nonlinear_force(p, psi, slots, dx)),
     }
-    nonlinear = energies.strain_energy_gradient_terms(p, U, geometric_nonlinearity=True)
+    nonlinear = energies.strain_energy_gradient_terms(p, U, geometric_nonlinearity=True, kinematics="printed")
     linear = energies.strain_energy_gradient_terms(p, U, geometric_nonlinearity=False)
     for k, (slot, gamma) in enumerate(printed.printed_gammas(p, slots).items(), start=1):
         catalog[f"Gamma_{k}"] = (f"Gamma_{k} as printed, Eq. ({104 + k}), multiplies psi slot {slot}", gamma)

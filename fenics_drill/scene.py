@@ -87,6 +87,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "stiffness_cubic": _nonneg("k_FS2 of Eq. (17) [N/m^3]", 1e16),
         "damping": _nonneg("c_FS of Eq. (17) [N s/m^4]", 1e6),
         "friction": _nonneg("mu_FS of Eqs. (18)-(19) [-]", 0.25),
+        "sliding_velocity_scale": _pos(
+            "v_s of the regularised sgn(v) = tanh(v / v_s) in (18)-(19), applied to the axial velocity "
+            "and to the surface speed R_bh theta_x_dot [m/s]", 1e-3,
+        ),
     },
     "bit_rock": {
         "limit_force": _nonneg("Gamma_BR of Eq. (20) [N]", 30e3),
@@ -99,6 +103,33 @@ SCHEMA: dict[str, dict[str, Key]] = {
     },
     "time": {
         "t_end": _pos("end of the simulated interval [s]", 10.0),
+        "dt": Key(
+            float, -1.0, "nominal time step [s]; -1: 1/(2 f_max) with f_max = f*_max c_L / L (Section 6.2)",
+            lambda x: x == -1.0 or x > 0, "> 0 (or -1 for the paper's nominal step)",
+        ),
+        "newmark_alpha": Key(
+            float, 0.015, "alpha of Newmark's gamma = 1/2 + alpha, beta = (1/2 + gamma)^2 / 4 (Section 4.3) [-]",
+            lambda x: 0 <= x <= 0.5, "in [0, 0.5]",
+        ),
+        "adaptive": _flag("refine the step where the local error estimate exceeds time.error_tolerance"),
+        "error_tolerance": _pos(
+            "admissible local error of the lateral vertex displacements per step [m]", 1e-5
+        ),
+        "max_step_cuts": Key(
+            int, 12, "the smallest step is dt / 2^max_step_cuts; a run needing less stops [-]",
+            lambda n: 0 <= n <= 40, "an integer in [0, 40]",
+        ),
+    },
+    "solver": {
+        "newton_tolerance": _pos("relative residual at which Newton stops [-]", 1e-8),
+        "newton_max_iterations": Key(int, 25, "Newton iterations before the step is cut [-]", _positive, ">= 1"),
+    },
+    "output": {
+        "section": Key(
+            float, -1.0, "x of the cross-section whose lateral motion is recorded [m]; -1: mid-length L/2",
+            lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for L/2)",
+        ),
+        "field_interval": _nonneg("simulated time between XDMF field snapshots [s]; 0: no fields", 0.1),
     },
     "model": {
         "supports": Key(
@@ -112,6 +143,12 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "bit_rock": _flag("evaluate the bit-rock force and torque (20)-(22)"),
         "geometric_nonlinearity": _flag("assemble the geometric nonlinear force F_SE (49)"),
         "inertial_nonlinearity": _flag("assemble the inertial nonlinear force F_KE (48)"),
+        "kinematics": Key(
+            str, "objective",
+            "cross-section kinematics of the strain energy: 'objective' (strains unchanged by a rigid "
+            "spin theta_x, docs/errata.md) or 'printed' (Eq. 14 as printed)",
+            choices=("objective", "printed"),
+        ),
     },
     "modal": {
         "f_star_max": _pos("upper end of the dimensionless band of analysis B = [0, f*_max], Eq. (95) [-]", 4.0),
@@ -177,6 +214,13 @@ def _check_relations(scene: dict[str, dict[str, Any]]) -> None:
         raise SceneError(
             f"borehole.radius = {hole['radius']!r} is not admissible: "
             f"must be > beam.outer_radius = {beam['outer_radius']!r} (the string must fit in the hole)"
+        )
+    if scene["output"]["section"] == -1.0:
+        scene["output"]["section"] = 0.5 * beam["length"]
+    if scene["output"]["section"] > beam["length"]:
+        raise SceneError(
+            f"output.section = {scene['output']['section']!r} is not admissible: "
+            f"must be in [0, beam.length = {beam['length']!r}]"
         )
     red = scene["reduction"]
     if red["rule"] in ("band", "count"):

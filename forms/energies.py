@@ -31,17 +31,41 @@ def strain_slots(U) -> dict:
     return dict(zip(STRAIN_SLOTS, (U[3], U[4], U[5], d(U[0]), d(U[1]), d(U[2]), d(U[3]), d(U[4]), d(U[5]))))
 
 
-def green_lagrange_strains(s: dict) -> tuple[SectionPolynomial, SectionPolynomial, SectionPolynomial]:
-    """(eps_xx, eps_xy, eps_xz) from the kinematics (14), Eqs. (31)-(33), as polynomials in (y, z)."""
+#: Kinematics of the cross-section (docs/errata.md, "Kinematics (14)"):
+#: 'printed' is Eq. (14), u_x = u - y theta_z + z theta_y with (y, z) the undeformed
+#: position, whose strains (35)-(36) change under a rigid spin theta_x; 'objective'
+#: tilts the section about the inertial axes at its spun position
+#: (Y, Z) = (y cos theta_x - z sin theta_x, y sin theta_x + z cos theta_x).
+KINEMATICS = ("objective", "printed")
+
+
+def _axial_tilt(s: dict, kinematics: str):
+    """u_x - u = y a + z b: the coefficients (a, b) and their axial derivatives."""
+    if kinematics == "printed":
+        return -s["theta_z"], s["theta_y"], -s["dtheta_z"], s["dtheta_y"]
+    if kinematics != "objective":
+        raise ValueError(f"unknown kinematics {kinematics!r}; expected one of {KINEMATICS}")
+    S, C = ufl.sin(s["theta_x"]), ufl.cos(s["theta_x"])
+    ty, tz, dtx, dty, dtz = s["theta_y"], s["theta_z"], s["dtheta_x"], s["dtheta_y"], s["dtheta_z"]
+    a = -C * tz + S * ty
+    b = S * tz + C * ty
+    da = dtx * (S * tz + C * ty) - C * dtz + S * dty
+    db = dtx * (C * tz - S * ty) + S * dtz + C * dty
+    return a, b, da, db
+
+
+def green_lagrange_strains(s: dict, kinematics: str = "objective") -> tuple[SectionPolynomial, SectionPolynomial, SectionPolynomial]:
+    """(eps_xx, eps_xy, eps_xz) of Eqs. (31)-(33) for the kinematics (14), as polynomials in (y, z)."""
     S, C = ufl.sin(s["theta_x"]), ufl.cos(s["theta_x"])
     P = SectionPolynomial
     tx1 = s["dtheta_x"]
-    # displacement gradient of (14): d(u_x, u_y, u_z)/d(x, y, z)
-    dux_dx = P({(0, 0): s["du"], (1, 0): -s["dtheta_z"], (0, 1): s["dtheta_y"]})
+    a, b, da, db = _axial_tilt(s, kinematics)
+    # displacement gradient: d(u_x, u_y, u_z)/d(x, y, z)
+    dux_dx = P({(0, 0): s["du"], (1, 0): da, (0, 1): db})
     duy_dx = P({(0, 0): s["dv"], (1, 0): -S * tx1, (0, 1): -C * tx1})
     duz_dx = P({(0, 0): s["dw"], (1, 0): C * tx1, (0, 1): -S * tx1})
-    dux_dy, duy_dy, duz_dy = P.constant(-s["theta_z"]), P.constant(C - 1.0), P.constant(S)
-    dux_dz, duy_dz, duz_dz = P.constant(s["theta_y"]), P.constant(-S), P.constant(C - 1.0)
+    dux_dy, duy_dy, duz_dy = P.constant(a), P.constant(C - 1.0), P.constant(S)
+    dux_dz, duy_dz, duz_dz = P.constant(b), P.constant(-S), P.constant(C - 1.0)
     eps_xx = dux_dx + (dux_dx * dux_dx + duy_dx * duy_dx + duz_dx * duz_dx).scale(0.5)
     eps_xy = (duy_dx + dux_dy).scale(0.5) + (dux_dx * dux_dy + duy_dx * duy_dy + duz_dx * duz_dy).scale(0.5)
     eps_xz = (duz_dx + dux_dz).scale(0.5) + (dux_dx * dux_dz + duy_dx * duy_dz + duz_dx * duz_dz).scale(0.5)
@@ -57,9 +81,10 @@ def linear_strains(s: dict) -> tuple[SectionPolynomial, SectionPolynomial, Secti
     return eps_xx, eps_xy, eps_xz
 
 
-def strain_energy_density(p: BeamProperties, s: dict, geometric_nonlinearity: bool = True):
+def strain_energy_density(p: BeamProperties, s: dict, geometric_nonlinearity: bool = True,
+                          kinematics: str = "objective"):
     """Strain energy per unit length, Eq. (30): 1/2 int_S (E e_xx^2 + 4 ks G (e_xy^2 + e_xz^2)) dA."""
-    exx, exy, exz = green_lagrange_strains(s) if geometric_nonlinearity else linear_strains(s)
+    exx, exy, exz = green_lagrange_strains(s, kinematics) if geometric_nonlinearity else linear_strains(s)
     E, kG = p.young_modulus, p.shear_factor * p.shear_modulus
     ro, ri = p.outer_radius, p.inner_radius
     return 0.5 * (E * (exx * exx).integrate(ro, ri) + 4.0 * kG * (exy * exy + exz * exz).integrate(ro, ri))
@@ -98,9 +123,10 @@ def inertial_force(p: BeamProperties, psi, U, V, A, dx, inertial_nonlinearity: b
     return ufl.derivative(momentum, U, V) + ufl.derivative(momentum, V, A) - ufl.derivative(T, U, psi)
 
 
-def elastic_force(p: BeamProperties, psi, U, dx, geometric_nonlinearity: bool = True):
+def elastic_force(p: BeamProperties, psi, U, dx, geometric_nonlinearity: bool = True, kinematics: str = "objective"):
     """dV/dU [psi] (= K(psi, U) - F_SE(psi), Eqs. 46, 49)."""
-    return ufl.derivative(strain_energy_density(p, strain_slots(U), geometric_nonlinearity) * dx, U, psi)
+    W = strain_energy_density(p, strain_slots(U), geometric_nonlinearity, kinematics)
+    return ufl.derivative(W * dx, U, psi)
 
 
 def damping_force(p: BeamProperties, psi, V, dx):
@@ -108,9 +134,10 @@ def damping_force(p: BeamProperties, psi, V, dx):
     return ufl.derivative(dissipation_density(p, V) * dx, V, psi)
 
 
-def strain_energy_gradient_terms(p: BeamProperties, U, geometric_nonlinearity: bool = True) -> dict:
+def strain_energy_gradient_terms(p: BeamProperties, U, geometric_nonlinearity: bool = True,
+                                 kinematics: str = "objective") -> dict:
     """dW/d(slot) for each slot of :data:`STRAIN_SLOTS`: the factors multiplying psi_tx, ...,
     psi_tz' in dV/dU[psi] (the energy-derived counterparts of Gamma_1..Gamma_9 plus K)."""
     slots = {name: ufl.variable(expr) for name, expr in strain_slots(U).items()}
-    W = strain_energy_density(p, slots, geometric_nonlinearity)
+    W = strain_energy_density(p, slots, geometric_nonlinearity, kinematics)
     return {name: ufl.diff(W, var) for name, var in slots.items()}

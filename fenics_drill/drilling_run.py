@@ -1,0 +1,192 @@
+"""``fenics-drill run`` and ``fenics-drill static``: a scene in, files out.
+
+run: DIR/summary.json, DIR/timeseries.h5 (see :mod:`fenics_drill.timeseries`),
+DIR/fields.xdmf (u, v, w, theta_x, theta_y, theta_z on P1 every
+``output.field_interval`` seconds).  The summary is written however the run
+ends (finished, failed with the reason, or interrupted with Ctrl-C) and says which.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from fenics_drill.drillstring_model import DrillstringModel, build_model
+from fenics_drill.field_output import FieldWriter
+from fenics_drill.simulation import Simulation, StepRecord
+from fenics_drill.static import StaticFailure, solve_static, static_report
+from fenics_drill.step_control import StepTooSmall, nominal_step
+from fenics_drill.timeseries import TimeSeriesWriter
+
+
+def _write_json(path: Path, data: dict) -> None:
+    path.write_text(json.dumps(data, indent=1, default=float))
+
+
+def run_static(scene: dict, out: str | Path) -> dict:
+    """Static equilibrium of the scene (Section 6.4): DIR/static.json and DIR/static.xdmf."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    model = build_model(scene)
+    equilibrium = solve_static(model)
+    report = static_report(model, equilibrium)
+    report["reduced_size"] = model.size
+    writer = FieldWriter(model.disc, out / "static.xdmf")
+    writer.write(model.space.expand(equilibrium.q), 0.0)
+    writer.close()
+    _write_json(out / "static.json", report)
+    return report
+
+
+class Progress:
+    """One line on stderr every few seconds: simulated time, steps, step size, wall time, ETA."""
+
+    def __init__(self, enabled: bool, every_s: float = 2.0):
+        self.enabled, self.every_s, self.last = enabled, every_s, -np.inf
+
+    def __call__(self, t, t_end, stats, dt, wall):
+        if not self.enabled or (wall - self.last < self.every_s and t < t_end):
+            return
+        self.last = wall
+        eta = wall * (t_end - t) / t if t > 0 else float("nan")
+        sys.stderr.write(
+            f"\r  t = {t:8.4f} / {t_end:g} s ({100 * t / t_end:5.1f}%)  steps {stats['steps']:7d}  "
+            f"dt {dt:.2e} s  wall {wall:7.1f} s  eta {eta:7.1f} s"
+        )
+        if t >= t_end * (1 - 1e-12):
+            sys.stderr.write("\n")
+        sys.stderr.flush()
+
+
+class RunRecorder:
+    """Turns accepted steps into time-series rows, XDMF snapshots and running integrals."""
+
+    def __init__(self, model: DrillstringModel, scene: dict, out: Path):
+        self.model = model
+        disc = model.disc
+        section = int(np.argmin(np.abs(disc.vertex_x - scene["output"]["section"])))
+        self.section_x = float(disc.vertex_x[section])
+        v_rows, w_rows = model.lateral_rows
+        tx_rows = model.space.rows(disc.vertex_dofs(3))
+        self.section_rows = (v_rows[[section]], w_rows[[section]], tx_rows[[section]])
+        self.series = TimeSeriesWriter(out / "timeseries.h5", disc.vertex_x, {
+            "section_x": self.section_x, "scene": json.dumps(scene), "reduced_size": model.size,
+        })
+        self.field_interval = scene["output"]["field_interval"]
+        self.fields = FieldWriter(disc, out / "fields.xdmf") if self.field_interval > 0 else None
+        self.next_field_time = 0.0
+        self.positive_bit_travel = 0.0  # int u_dot_bit^+ dt, Eq. (99)
+        self.power_in = self.power_out = 0.0  # int P_in dt, int P_out dt, Eqs. (96)-(98)
+        self._last = None
+
+    def _powers(self, record: StepRecord, bit_velocity: float, bit_spin: float) -> tuple[float, float]:
+        plus = lambda x: max(x, 0.0)  # noqa: E731
+        force, torque = -record.state.mu
+        p_in = plus(self.model.drive_rate[0]) * plus(force) + plus(self.model.drive_rate[1]) * plus(torque)
+        bit = record.evaluation.bit
+        p_out = 0.0 if bit is None else plus(bit_velocity) * plus(-bit.force) + plus(bit_spin) * plus(-bit.torque)
+        return p_in, p_out
+
+    def write_fields(self, state, force: bool = False) -> None:
+        if self.fields is not None and (force or state.t >= self.next_field_time - 1e-12):
+            self.fields.write(self.model.space.expand(state.q), state.t)
+            self.next_field_time = state.t + self.field_interval
+
+    def __call__(self, record: StepRecord) -> None:
+        s = record.state
+        u, du, tx, dtx = self.model.bit_state(s.q, s.qd)
+        p_in, p_out = self._powers(record, du, dtx)
+        if self._last is not None:
+            du0, p_in0, p_out0 = self._last
+            self.positive_bit_travel += 0.5 * (max(du0, 0.0) + max(du, 0.0)) * record.dt
+            self.power_in += 0.5 * (p_in0 + p_in) * record.dt
+            self.power_out += 0.5 * (p_out0 + p_out) * record.dt
+        self._last = (du, p_in, p_out)
+        bit = record.evaluation.bit
+        v, w, sx = (float((rows @ s.q)[0]) for rows in self.section_rows)
+        dv, dw, dsx = (float((rows @ s.qd)[0]) for rows in self.section_rows)
+        budget = record.budget
+        self.series.append({
+            "time": s.t, "dt": record.dt, "newton_iterations": record.newton_iterations,
+            "bit_displacement": u, "bit_velocity": du, "bit_rotation": tx, "bit_angular_velocity": dtx,
+            "bit_force": 0.0 if bit is None else bit.force, "bit_torque": 0.0 if bit is None else bit.torque,
+            "lambda_1": -s.mu[0], "lambda_4": -s.mu[1],
+            "impacts": int(record.onsets.sum()), "vertices_in_contact": int(record.in_contact.sum()),
+            "section_v": v, "section_w": w, "section_v_velocity": dv, "section_w_velocity": dw,
+            "section_theta_x_velocity": dsx,
+            "kinetic_energy": budget.kinetic, "strain_energy": budget.strain,
+            "input_work": budget.input_work, "dissipated_energy": budget.total_dissipated,
+        })
+        self.write_fields(s)
+
+    def close(self, impacts_per_vertex: np.ndarray) -> None:
+        self.series.close(impacts_per_vertex)
+        if self.fields is not None:
+            self.fields.close()
+
+
+def run_scene(scene: dict, out: str | Path, progress: bool = True) -> dict:
+    """Static equilibrium, then the drilling dynamics to time.t_end; returns the summary."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    clock = time.perf_counter()
+    summary: dict = {"status": "failed", "message": "", "t_end": 0.0, "steps": 0}
+    recorder = simulation = None
+    try:
+        model = build_model(scene)
+        summary["reduced_size"], summary["full_dofs"] = model.size, model.disc.ndofs
+        summary["setup_time_s"] = time.perf_counter() - clock
+        equilibrium = solve_static(model)
+        summary["static"] = {k: v for k, v in static_report(model, equilibrium).items() if k != "contact_vertices"}
+        simulation = Simulation(model, scene)
+        start = simulation.initial_state(equilibrium.q, equilibrium.mu)
+        recorder = RunRecorder(model, scene, out)
+        recorder.write_fields(start, force=True)
+        u0 = model.bit_state(start.q, start.qd)[0]
+        summary["nominal_dt"] = nominal_step(scene)
+        loop_clock = time.perf_counter()
+        try:
+            final = simulation.run(start, scene["time"]["t_end"], recorder, Progress(progress))
+            summary["status"], summary["message"] = "finished", "reached time.t_end"
+        except StepTooSmall as failure:
+            final = None
+            summary["message"] = str(failure)
+        summary["integration_time_s"] = time.perf_counter() - loop_clock
+        last = final if final is not None else simulation.last_state
+        summary.update(_dynamics_summary(model, simulation, recorder, last, u0))
+    except KeyboardInterrupt:
+        summary["status"], summary["message"] = "interrupted", "stopped by the user (Ctrl-C)"
+        if simulation is not None and recorder is not None and simulation.last_state is not None:
+            summary.update(_dynamics_summary(model, simulation, recorder, simulation.last_state, u0))
+    except StaticFailure as failure:
+        summary["message"] = f"at t = 0 s: {failure}"
+    finally:
+        if recorder is not None:
+            recorder.close(simulation.impacts_per_vertex)
+        summary["wall_time_s"] = time.perf_counter() - clock
+        _write_json(out / "summary.json", summary)
+    return summary
+
+
+def _dynamics_summary(model, simulation: Simulation, recorder: RunRecorder, state, u0: float) -> dict:
+    t = state.t
+    u = model.bit_state(state.q, state.qd)[0]
+    stats = simulation.stats
+    return {
+        "t_end": t,
+        "steps": stats["steps"],
+        "rejected_steps": stats["rejected_steps"],
+        "newton_failures": stats["newton_failures"],
+        "newton_iterations": stats["newton_iterations"],
+        "min_dt": stats["min_dt"], "max_dt": stats["max_dt"],
+        "mean_bit_velocity": (u - u0) / t if t > 0 else 0.0,
+        "rop": recorder.positive_bit_travel / t if t > 0 else 0.0,
+        "efficiency": recorder.power_out / recorder.power_in if recorder.power_in > 0 else 0.0,
+        "impacts_total": int(simulation.impacts_per_vertex.sum()),
+        "section_x": recorder.section_x,
+        "energy": simulation.budget.summary(),
+    }
