@@ -52,6 +52,7 @@ class NewmarkNewton:
         self.tolerance, self.max_iterations = tolerance, max_iterations
         self._internal_parts = None
         self._steps_since_tangent = 0
+        self._force_level = 0.0
 
     def constraint_target(self, t: float, h0: np.ndarray) -> np.ndarray:
         """h(t) of (71) for the rows the basis leaves: u(0, t) = V0 t, theta_x(0, t) = Omega t."""
@@ -99,11 +100,15 @@ class NewmarkNewton:
         stale = self._internal_parts is None or self._steps_since_tangent >= TANGENT_REUSE_STEPS
         qd, qdd, ev = evaluate(q, mu, stale and self.model.internal.state_dependent)
         norm = np.linalg.norm(ev.residual)
+        # forces can balance to round-off (e.g. M qdd + K q in free vibration): also measure
+        # against the predictor's residual and the force level of earlier steps
+        self._force_level = max(self._force_level, norm)
         for iteration in range(1, self.max_iterations + 1):
             gap = B @ q - target
             if not np.isfinite(norm):
                 break
-            if norm <= self.tolerance * self._scale(ev, B.T @ mu) and np.all(
+            self._force_level = max(self._force_level, self._scale(ev, B.T @ mu))
+            if norm <= self.tolerance * self._force_level and np.all(
                 np.abs(gap) <= self.tolerance * np.maximum(np.abs(target), 1.0)
             ):
                 self._steps_since_tangent += 1

@@ -37,9 +37,9 @@ def _forms(disc: BeamDiscretization):
     p = disc.properties
     return (
         fem.form(mass_form(p, psi, U, dx)),
-        fem.form(damping_form(p, psi, U, dx)),
+        fem.form(damping_form(p, psi, U, dx)) if p.damping != 0 else None,  # c = 0: UFL's zero form
         fem.form(stiffness_form(p, psi, U, dx)),
-        fem.form(gravity_form(p, psi, dx)),
+        fem.form(gravity_form(p, psi, dx)) if p.gravity != 0 else None,  # g = 0: UFL's zero form
     )
 
 
@@ -48,13 +48,18 @@ def assemble_linear(disc: BeamDiscretization) -> LinearOperators:
     m, c, k, g = _forms(disc)
 
     def mat(a):
+        if a is None:
+            return sp.csr_matrix((disc.ndofs, disc.ndofs))
         A = fem_petsc.assemble_matrix(a)
         A.assemble()
         return petsc_to_scipy(A)
 
-    b = fem_petsc.assemble_vector(g)
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    return LinearOperators(mat(m), mat(c), mat(k), b.array.copy())
+    gravity = np.zeros(disc.ndofs)
+    if g is not None:
+        b = fem_petsc.assemble_vector(g)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        gravity = b.array.copy()
+    return LinearOperators(mat(m), mat(c), mat(k), gravity)
 
 
 def assemble_modal_pair(disc: BeamDiscretization) -> tuple[PETSc.Mat, PETSc.Mat]:

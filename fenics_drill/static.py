@@ -38,7 +38,7 @@ class StaticEquilibrium:
     residual: float  # relative
 
 
-def solve_static(model: DrillstringModel, tolerance: float = 1e-10, max_iterations: int = 200) -> StaticEquilibrium:
+def solve_static(model: DrillstringModel, tolerance: float = 1e-8, max_iterations: int = 200) -> StaticEquilibrium:
     """Equilibrium of the string at rest (velocities zero, so no friction and no bit-rock force)."""
     q, mu = np.zeros(model.size), np.zeros(2)
     if model.wall is None:
