@@ -94,7 +94,7 @@ class RunRecorder:
     def write_fields(self, state, force: bool = False) -> None:
         if self.fields is not None and (force or state.t >= self.next_field_time - 1e-12):
             self.fields.write(self.model.space.expand(state.q), state.t)
-            self.next_field_time = state.t + self.field_interval
+            self.next_field_time = self.field_interval * (np.floor(state.t / self.field_interval + 1e-9) + 1)
 
     def __call__(self, record: StepRecord) -> None:
         s = record.state

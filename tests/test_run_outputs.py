@@ -1,0 +1,54 @@
+"""fenics-drill run / static: the files a user opens, and what an interrupted or failed run keeps."""
+
+import json
+
+import h5py
+import numpy as np
+import pytest
+import xarray as xr
+
+from fenics_drill.cli import main
+
+SHORT = ["--set", "beam.length=10.0", "--set", "beam.elements=10", "--set", "time.t_end=0.05",
+         "--set", "output.field_interval=0.01", "--set", "reduction.rule='count'",
+         "--set", "reduction.flexural=6", "--set", "reduction.torsional=2", "--set", "reduction.axial=2"]
+
+
+def test_run_writes_summary_timeseries_and_fields(tmp_path):
+    assert main(["run", *SHORT, "--quiet", "--out", str(tmp_path)]) == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["status"] == "finished"
+    assert summary["t_end"] == pytest.approx(0.05)
+    for key in ("steps", "newton_iterations", "wall_time_s", "mean_bit_velocity", "rop", "impacts_total"):
+        assert key in summary
+    assert set(summary["energy"]) >= {"input_work", "kinetic", "strain", "dissipated", "balance_error"}
+    ds = xr.open_dataset(tmp_path / "timeseries.h5", engine="h5netcdf", phony_dims="sort")
+    assert ds.sizes["time"] == summary["steps"]
+    assert ds["bit_velocity"].attrs["units"] == "m/s"
+    assert ds["impacts_per_vertex"].dims == ("vertex_x",)
+    # the bit displacement is the integral of the bit velocity (trapezoidal rule of Newmark, gamma ~ 1/2)
+    t = np.concatenate([[0.0], ds["time"].values])
+    with h5py.File(tmp_path / "timeseries.h5") as f:
+        u, v = f["bit_displacement"][()], f["bit_velocity"][()]
+    travel = np.trapezoid(v, t[1:])
+    assert u[-1] - u[0] == pytest.approx(travel, rel=0.05)
+    xdmf = (tmp_path / "fields.xdmf").read_text()
+    with h5py.File(tmp_path / "fields.h5") as f:
+        assert set(f["Function"]) == {"u", "v", "w", "theta_x", "theta_y", "theta_z"}
+        snapshots = list(f["Function/w"])
+        assert len(snapshots) == 6  # t = 0, 0.01, ..., 0.05
+        assert f["Function/w"][snapshots[0]].shape[0] == 11  # P1: one value per vertex
+    assert xdmf.count('Name="w"') == 6
+
+
+def test_static_writes_sag_and_contact_positions(tmp_path):
+    assert main(["static", *SHORT[:4], "--set", "model.supports='pinned'", "--out", str(tmp_path)]) == 0
+    report = json.loads((tmp_path / "static.json").read_text())
+    assert report["max_sag"] > 0
+    assert isinstance(report["contact_vertices"], list)
+
+
+def test_bad_scene_is_refused_before_computing(tmp_path, capsys):
+    assert main(["run", "--set", "time.newmark_alpha=0.9", "--out", str(tmp_path)]) == 2
+    assert "time.newmark_alpha" in capsys.readouterr().err
+    assert not (tmp_path / "summary.json").exists()
