@@ -38,6 +38,16 @@ def _pair(path, t, top, bottom, top_label, bottom_label, title):
     plt.close(fig)
 
 
+def _single(path, draw, xlabel, ylabel, title):
+    fig, ax = plt.subplots(figsize=(8, 3.5))
+    draw(ax)
+    ax.set(xlabel=xlabel, ylabel=ylabel, title=title)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def make_figures(run_dir: Path) -> list[Path]:
     with h5py.File(run_dir / "timeseries.h5", "r") as f:
         d = {k: f[k][()] for k in f.keys()}
@@ -56,27 +66,17 @@ def make_figures(run_dir: Path) -> list[Path]:
     _pair(p, t, d["section_w"] * 1e3, d["section_w_velocity"], "w [mm]", "w velocity [m/s]",
           f"Fig. 16: transverse motion at x = {section_x:g} m")
     out.append(p)
-    fig, ax = plt.subplots(figsize=(8, 3.5))
-    ax.plot(t, np.hypot(d["section_v"], d["section_w"]) * 1e3, lw=0.8)
-    ax.set(xlabel="time [s]", ylabel="radial displacement [mm]", title=f"Fig. 17: radial displacement at x = {section_x:g} m")
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
     p = run_dir / "fig17_section_radial.png"
-    fig.savefig(p, dpi=120)
-    plt.close(fig)
+    _single(p, lambda ax: ax.plot(t, np.hypot(d["section_v"], d["section_w"]) * 1e3, lw=0.8),
+            "time [s]", "radial displacement [mm]", f"Fig. 17: radial displacement at x = {section_x:g} m")
     out.append(p)
     p = run_dir / "fig18_impacts_time.png"
     _pair(p, t, d["impacts"], d["vertices_in_contact"], "impacts per step", "vertices in contact",
           "Fig. 18: wall impacts against time")
     out.append(p)
-    fig, ax = plt.subplots(figsize=(8, 3.5))
-    ax.bar(d["vertex_x"], d["impacts_per_vertex"], width=d["vertex_x"][1] - d["vertex_x"][0])
-    ax.set(xlabel="x [m]", ylabel="impacts", title="Fig. 19: wall impacts per vertex")
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
     p = run_dir / "fig19_impacts_position.png"
-    fig.savefig(p, dpi=120)
-    plt.close(fig)
+    _single(p, lambda ax: ax.bar(d["vertex_x"], d["impacts_per_vertex"], width=d["vertex_x"][1] - d["vertex_x"][0]),
+            "x [m]", "impacts", "Fig. 19: wall impacts per vertex")
     out.append(p)
     return out
 
