@@ -3,7 +3,17 @@
 ``dolfinx_solver`` must be imported before ``dolfinx`` and ``petsc4py`` so that
 the real-scalar PETSc/SLEPc of the ``dolfinx-solver-real`` wheel is the one
 loaded; importing this package does that once for every module below it.
+
+The dense algebra of a reduced model works on 44 x 44 matrices and 4006 x 44
+bases: threaded BLAS only adds overhead there, and two runs (or MPI ranks) on a
+2-core machine then oversubscribe it (measured: 113 s against 50 s for the
+nominal 10 s run).  So one BLAS thread per process unless the user says otherwise.
 """
+
+import os
+
+for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_variable, "1")
 
 import dolfinx_solver  # noqa: F401  (must precede dolfinx / petsc4py)
 

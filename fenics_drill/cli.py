@@ -84,6 +84,20 @@ def cmd_run(args) -> int:
     return {"finished": 0, "interrupted": 130}.get(summary["status"], 1)
 
 
+def cmd_plot(args) -> int:
+    """Figures of a saved run: Figs. 13-23 as PNG, spectra.json, animation.gif."""
+    from fenics_drill.run_figures import plot_run
+
+    run_dir = Path(args.run_dir)
+    if not (run_dir / "timeseries.h5").exists():
+        print(f"fenics-drill: {run_dir} holds no timeseries.h5 (is it the --out of 'fenics-drill run'?)",
+              file=sys.stderr)
+        return 2
+    paths = plot_run(run_dir, gif=not args.no_gif)
+    print(f"{len(paths)} files in {run_dir}: " + ", ".join(p.name for p in paths))
+    return 0
+
+
 def cmd_forms(args) -> int:
     """List the forms, print one, or check the printed operators against the energies."""
     from fenics_drill.discretization import BeamDiscretization
@@ -134,6 +148,10 @@ def build_parser() -> argparse.ArgumentParser:
     _scene_args(p)
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_run)
+    p = sub.add_parser("plot", help="figures of a saved run (Figs. 13-23), spectra.json, animation.gif")
+    p.add_argument("run_dir", help="the --out directory of 'fenics-drill run'")
+    p.add_argument("--no-gif", action="store_true", help="skip the animation (the slowest part)")
+    p.set_defaults(func=cmd_plot)
     p = sub.add_parser("forms", help="list/show the weak forms, or check the printed ones against the energies")
     p.add_argument("action", choices=("list", "show", "check"))
     p.add_argument("name", nargs="?", help="with 'show': the form to print (see 'forms list')")

@@ -15,12 +15,14 @@ from pathlib import Path
 
 import numpy as np
 
+from fenics_drill.drilling_quantities import from_timeseries, read_series
 from fenics_drill.drillstring_model import DrillstringModel, build_model
 from fenics_drill.field_output import FieldWriter
 from fenics_drill.simulation import Simulation, StepRecord
 from fenics_drill.static import StaticFailure, solve_static, static_report
 from fenics_drill.step_control import StepTooSmall, nominal_step
 from fenics_drill.timeseries import TimeSeriesWriter
+from fenics_drill.von_mises import VonMisesProbe
 
 
 def _write_json(path: Path, data: dict) -> None:
@@ -63,7 +65,7 @@ class Progress:
 
 
 class RunRecorder:
-    """Turns accepted steps into time-series rows, XDMF snapshots and running integrals."""
+    """Turns accepted steps (and the initial state) into time-series rows and XDMF snapshots."""
 
     def __init__(self, model: DrillstringModel, scene: dict, out: Path):
         self.model = model
@@ -74,54 +76,43 @@ class RunRecorder:
         tx_rows = model.space.rows(disc.vertex_dofs(3))
         self.section_rows = (v_rows[[section]], w_rows[[section]], tx_rows[[section]])
         self.series = TimeSeriesWriter(out / "timeseries.h5", disc.vertex_x, {
-            "section_x": self.section_x, "scene": json.dumps(scene), "reduced_size": model.size,
-        })
+            "section_x": self.section_x, "gap": model.gap, "scene": json.dumps(scene), "reduced_size": model.size,
+        }, model.modes)
+        flags = scene["model"]
+        self.stress = VonMisesProbe(disc, flags["geometric_nonlinearity"], flags["kinematics"]) \
+            if scene["output"]["von_mises"] else None
         self.field_interval = scene["output"]["field_interval"]
-        self.fields = FieldWriter(disc, out / "fields.xdmf") if self.field_interval > 0 else None
+        self.fields = FieldWriter(disc, out / "fields.xdmf", with_stress=self.stress is not None) \
+            if self.field_interval > 0 else None
         self.next_field_time = 0.0
-        self.positive_bit_travel = 0.0  # int u_dot_bit^+ dt, Eq. (99)
-        self.power_in = self.power_out = 0.0  # int P_in dt, int P_out dt, Eqs. (96)-(98)
-        self._last = None
 
-    def _powers(self, record: StepRecord, bit_velocity: float, bit_spin: float) -> tuple[float, float]:
-        plus = lambda x: max(x, 0.0)  # noqa: E731
-        force, torque = -record.state.mu
-        p_in = plus(self.model.drive_rate[0]) * plus(force) + plus(self.model.drive_rate[1]) * plus(torque)
-        bit = record.evaluation.bit
-        p_out = 0.0 if bit is None else plus(bit_velocity) * plus(-bit.force) + plus(bit_spin) * plus(-bit.torque)
-        return p_in, p_out
-
-    def write_fields(self, state, force: bool = False) -> None:
-        if self.fields is not None and (force or state.t >= self.next_field_time - 1e-12):
-            self.fields.write(self.model.space.expand(state.q), state.t)
-            self.next_field_time = self.field_interval * (np.floor(state.t / self.field_interval + 1e-9) + 1)
+    def _write_fields(self, t: float, dofs: np.ndarray) -> None:
+        if self.fields is not None and t >= self.next_field_time - 1e-12:
+            stress = self.stress.cell_stress(dofs) if self.stress is not None else None
+            self.fields.write(dofs, t, stress)
+            self.next_field_time = self.field_interval * (np.floor(t / self.field_interval + 1e-9) + 1)
 
     def __call__(self, record: StepRecord) -> None:
         s = record.state
         u, du, tx, dtx = self.model.bit_state(s.q, s.qd)
-        p_in, p_out = self._powers(record, du, dtx)
-        if self._last is not None:
-            du0, p_in0, p_out0 = self._last
-            self.positive_bit_travel += 0.5 * (max(du0, 0.0) + max(du, 0.0)) * record.dt
-            self.power_in += 0.5 * (p_in0 + p_in) * record.dt
-            self.power_out += 0.5 * (p_out0 + p_out) * record.dt
-        self._last = (du, p_in, p_out)
         bit = record.evaluation.bit
-        v, w, sx = (float((rows @ s.q)[0]) for rows in self.section_rows)
+        v, w, _ = (float((rows @ s.q)[0]) for rows in self.section_rows)
         dv, dw, dsx = (float((rows @ s.qd)[0]) for rows in self.section_rows)
+        dofs = self.model.space.expand(s.q)
+        stress, stress_x = self.stress.maximum(dofs) if self.stress is not None else (np.nan, np.nan)
         budget = record.budget
         self.series.append({
             "time": s.t, "dt": record.dt, "newton_iterations": record.newton_iterations,
             "bit_displacement": u, "bit_velocity": du, "bit_rotation": tx, "bit_angular_velocity": dtx,
             "bit_force": 0.0 if bit is None else bit.force, "bit_torque": 0.0 if bit is None else bit.torque,
-            "lambda_1": -s.mu[0], "lambda_4": -s.mu[1],
+            "lambda_1": s.mu[0], "lambda_4": s.mu[1],
             "impacts": int(record.onsets.sum()), "vertices_in_contact": int(record.in_contact.sum()),
             "section_v": v, "section_w": w, "section_v_velocity": dv, "section_w_velocity": dw,
-            "section_theta_x_velocity": dsx,
+            "section_theta_x_velocity": dsx, "max_von_mises": stress, "max_von_mises_x": stress_x,
             "kinetic_energy": budget.kinetic, "strain_energy": budget.strain,
             "input_work": budget.input_work, "dissipated_energy": budget.total_dissipated,
         })
-        self.write_fields(s)
+        self._write_fields(s.t, dofs)
 
     def close(self, impacts_per_vertex: np.ndarray) -> None:
         self.series.close(impacts_per_vertex)
@@ -145,7 +136,6 @@ def run_scene(scene: dict, out: str | Path, progress: bool = True) -> dict:
         simulation = Simulation(model, scene)
         start = simulation.initial_state(equilibrium.q, equilibrium.mu)
         recorder = RunRecorder(model, scene, out)
-        recorder.write_fields(start, force=True)
         u0 = model.bit_state(start.q, start.qd)[0]
         summary["nominal_dt"] = nominal_step(scene)
         loop_clock = time.perf_counter()
@@ -167,6 +157,7 @@ def run_scene(scene: dict, out: str | Path, progress: bool = True) -> dict:
     finally:
         if recorder is not None:
             recorder.close(simulation.impacts_per_vertex)
+            summary.update(_observables(out / "timeseries.h5"))
         summary["wall_time_s"] = time.perf_counter() - clock
         _write_json(out / "summary.json", summary)
     return summary
@@ -184,9 +175,21 @@ def _dynamics_summary(model, simulation: Simulation, recorder: RunRecorder, stat
         "newton_iterations": stats["newton_iterations"],
         "min_dt": stats["min_dt"], "max_dt": stats["max_dt"],
         "mean_bit_velocity": (u - u0) / t if t > 0 else 0.0,
-        "rop": recorder.positive_bit_travel / t if t > 0 else 0.0,
-        "efficiency": recorder.power_out / recorder.power_in if recorder.power_in > 0 else 0.0,
         "impacts_total": int(simulation.impacts_per_vertex.sum()),
         "section_x": recorder.section_x,
         "energy": simulation.budget.summary(),
     }
+
+
+def _observables(series_path: Path) -> dict:
+    """Drilling quantities (96)-(99), indicators and the von Mises maximum (100) of the saved series."""
+    data, _ = read_series(series_path)
+    if len(data["time"]) < 2:
+        return {}
+    out = from_timeseries(series_path)
+    stress = data["max_von_mises"]
+    if np.isfinite(stress).any():
+        k = int(np.nanargmax(stress))
+        out["max_von_mises"] = {"value": float(stress[k]), "x": float(data["max_von_mises_x"][k]),
+                                "t": float(data["time"][k])}
+    return out

@@ -4,9 +4,9 @@
     [B] q = h(t) = h0 + (V0, Omega) t
 
 f_int is the projected left-hand side of (43); f_G (52), f_FS (50) and f_BR (51) are
-built only when the scene's ``model`` switches them on.  The multipliers are
-stored as mu = -lambda: lambda_1, lambda_4 of (75) are the force and torque the
-drive applies at x = 0 (the rows of [B] the supports leave to enforce).
+built only when the scene's ``model`` switches them on.  The multipliers mu are
+the lambda of the Lagrangian (74): -lambda_1 and -lambda_4 are the force and
+torque the drive applies at x = 0 (the rows of [B] the supports leave to enforce).
 """
 
 from __future__ import annotations
@@ -42,8 +42,10 @@ class Evaluation:
 class DrillstringModel:
     """Operators, force laws and constraints of one scene in one solution space."""
 
-    def __init__(self, scene: dict, disc: BeamDiscretization, space, operators: LinearOperators, basis=None):
+    def __init__(self, scene: dict, disc: BeamDiscretization, space, operators: LinearOperators, basis=None,
+                 modes=None):
         self.scene, self.disc, self.space, self.basis = scene, disc, space, basis
+        self.modes = modes  # every mode of the band B, kept or not (to name spectral peaks)
         model = scene["model"]
         borehole_radius = scene["borehole"]["radius"]
         self.gap = borehole_radius - disc.properties.outer_radius
@@ -112,22 +114,22 @@ class DrillstringModel:
 
 
 def solution_space(scene: dict, disc: BeamDiscretization):
-    """Modal basis of the scene's reduction rule (Section 6.3), or the full space for 'none'."""
-    if scene["reduction"]["rule"] == "none":
-        return FullSpace(disc.ndofs, disc.support_dofs), None
+    """(space, kept modes, all modes): the modal basis of the scene's reduction rule (Section 6.3),
+    or the full space for 'none'; all modes of the band B (for spectra) either way."""
     from fenics_drill.modal import solve_modes
     from fenics_drill.reduction import select_modes
 
     p = disc.properties
-    basis = solve_modes(disc, scene["modal"]["f_star_max"])
-    kept = select_modes(basis, scene["reduction"], p.length, p.longitudinal_wave_speed)
-    basis = basis.select(kept)
-    return ModalSpace(basis.vectors), basis
+    modes = solve_modes(disc, scene["modal"]["f_star_max"])
+    if scene["reduction"]["rule"] == "none":
+        return FullSpace(disc.ndofs, disc.support_dofs), None, modes
+    basis = modes.select(select_modes(modes, scene["reduction"], p.length, p.longitudinal_wave_speed))
+    return ModalSpace(basis.vectors), basis, modes
 
 
 def build_model(scene: dict) -> DrillstringModel:
     """Discretize, solve the modal problem, choose the basis and build the model of a scene."""
     disc = scene_discretization(scene)
     operators = assemble_linear(disc)
-    space, basis = solution_space(scene, disc)
-    return DrillstringModel(scene, disc, space, operators, basis)
+    space, basis, modes = solution_space(scene, disc)
+    return DrillstringModel(scene, disc, space, operators, basis, modes)

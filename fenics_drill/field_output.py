@@ -1,4 +1,5 @@
-"""Displacement and rotation fields for ParaView: XDMF with u, v, w, theta_x, theta_y, theta_z on P1.
+"""Displacement and rotation fields for ParaView: XDMF with u, v, w, theta_x, theta_y, theta_z on P1
+and, for drilling runs, the element-wise maximum von Mises stress ``von_mises`` (DG0, Pa).
 
 XDMFFile writes functions of the mesh's degree only, so each sub-field of the
 mixed space is collapsed and interpolated to P1 (vertex values) before writing.
@@ -19,7 +20,7 @@ from fenics_drill.forms import FIELD_NAMES
 class FieldWriter:
     """Writes the six fields of full-space dof vectors at chosen times."""
 
-    def __init__(self, disc: BeamDiscretization, path: str | Path):
+    def __init__(self, disc: BeamDiscretization, path: str | Path, with_stress: bool = False):
         self.disc = disc
         self.file = io.XDMFFile(disc.comm, str(path), "w")
         self.file.write_mesh(disc.mesh)
@@ -29,12 +30,18 @@ class FieldWriter:
         for i, name in enumerate(FIELD_NAMES):
             f = fem.Function(p1, name=name)
             self.outputs.append((self.mixed.sub(i), f))
+        dg0 = fem.functionspace(disc.mesh, basix.ufl.element("DG", "interval", 0))
+        self.stress = fem.Function(dg0, name="von_mises") if with_stress else None
 
-    def write(self, dofs: np.ndarray, t: float) -> None:
+    def write(self, dofs: np.ndarray, t: float, cell_stress: np.ndarray | None = None) -> None:
+        """The six fields at time t, and the element-wise maximum von Mises stress if given [Pa]."""
         self.mixed.x.array[:] = dofs
         for sub, out in self.outputs:
             out.interpolate(sub)
             self.file.write_function(out, t)
+        if self.stress is not None and cell_stress is not None:
+            self.stress.x.array[:] = cell_stress
+            self.file.write_function(self.stress, t)
 
     def close(self) -> None:
         self.file.close()

@@ -23,7 +23,7 @@ class NewtonFailure(RuntimeError):
 
 @dataclass
 class State:
-    """Reduced displacement, velocity, acceleration and multipliers mu = -lambda at time t."""
+    """Reduced displacement, velocity, acceleration and multipliers mu (the lambda of (74)) at time t."""
 
     t: float
     q: np.ndarray

@@ -130,6 +130,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
             lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for L/2)",
         ),
         "field_interval": _nonneg("simulated time between XDMF field snapshots [s]; 0: no fields", 0.1),
+        "von_mises": _flag("record the maximum von Mises stress over the string at every step (Eq. 100)"),
     },
     "model": {
         "supports": Key(

@@ -76,7 +76,9 @@ class Simulation:
         return kinetic, strain, potential
 
     def run(self, state: State, t_end: float, on_step=None, progress=None) -> State:
-        """Step from ``state`` to t_end; raises StepTooSmall (with when and why) if the step collapses."""
+        """Step from ``state`` to t_end; raises StepTooSmall (with when and why) if the step collapses.
+
+        ``on_step`` sees the initial state (step_index 0) and then every accepted step."""
         model = self.model
         ev = model.evaluate(state.q, state.qd, state.qdd, state.mu)
         h0 = model.constraints @ state.q - model.drive_rate * state.t
@@ -87,6 +89,8 @@ class Simulation:
         in_contact = ev.wall.in_contact if ev.wall is not None else np.zeros(len(self.impacts_per_vertex), bool)
         clock = time.perf_counter()
         self.last_state = state
+        if on_step is not None:
+            on_step(StepRecord(state, 0.0, 0, ev, np.zeros_like(in_contact), in_contact, budget, 0))
         while state.t < t_end * (1 - 1e-12):
             dt = min(self.controller.dt, t_end - state.t)
             try:

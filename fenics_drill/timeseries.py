@@ -23,8 +23,8 @@ VARIABLES = {
     "bit_angular_velocity": ("rad/s", "angular velocity of the bit theta_x_dot(L)"),
     "bit_force": ("N", "bit-rock force F_BR, Eq. (20)"),
     "bit_torque": ("N m", "bit-rock torque T_BR, Eq. (21)"),
-    "lambda_1": ("N", "driving force at x = 0 (Lagrange multiplier lambda_1)"),
-    "lambda_4": ("N m", "driving torque at x = 0 (Lagrange multiplier lambda_4)"),
+    "lambda_1": ("N", "Lagrange multiplier lambda_1 of (74): -lambda_1 is the force the drive applies at x = 0"),
+    "lambda_4": ("N m", "Lagrange multiplier lambda_4 of (74): -lambda_4 is the torque the drive applies at x = 0"),
     "impacts": ("1", "vertices whose wall contact began during the step"),
     "vertices_in_contact": ("1", "vertices in contact with the wall at the end of the step"),
     "section_v": ("m", "lateral displacement v at the recorded section"),
@@ -32,6 +32,8 @@ VARIABLES = {
     "section_v_velocity": ("m/s", "lateral velocity v_dot at the recorded section"),
     "section_w_velocity": ("m/s", "lateral velocity w_dot at the recorded section"),
     "section_theta_x_velocity": ("rad/s", "angular velocity theta_x_dot at the recorded section"),
+    "max_von_mises": ("Pa", "maximum von Mises stress over the string (NaN if output.von_mises is off)"),
+    "max_von_mises_x": ("m", "x where the maximum von Mises stress sits"),
     "kinetic_energy": ("J", "kinetic energy, Eq. (24)"),
     "strain_energy": ("J", "strain energy, Eq. (30)"),
     "input_work": ("J", "work of the drive since t = 0"),
@@ -42,9 +44,10 @@ FLUSH_ROWS = 500
 
 
 class TimeSeriesWriter:
-    """Appends one row per accepted step to ``path`` (HDF5)."""
+    """Appends one row per accepted step to ``path`` (HDF5); the group ``modes`` holds
+    the natural frequencies and families of the band B, to name spectral peaks."""
 
-    def __init__(self, path: str | Path, vertex_x: np.ndarray, attributes: dict):
+    def __init__(self, path: str | Path, vertex_x: np.ndarray, attributes: dict, modes=None):
         self.file = h5py.File(path, "w")
         for key, value in attributes.items():
             self.file.attrs[key] = value
@@ -62,6 +65,12 @@ class TimeSeriesWriter:
         counts = self.file.create_dataset("impacts_per_vertex", data=np.zeros(len(vertex_x)))
         counts.attrs["units"], counts.attrs["long_name"] = "1", "wall impacts (contact onsets) per vertex"
         counts.dims[0].attach_scale(x)
+        if modes is not None:
+            group = self.file.create_group("modes")
+            group["frequency"] = modes.frequencies_hz
+            group["frequency"].attrs["units"] = "Hz"
+            group["frequency"].attrs["long_name"] = "natural frequencies of the band B (Eq. 62)"
+            group["kind"] = np.array(modes.kinds, dtype="S")
 
     def append(self, row: dict) -> None:
         for name in VARIABLES:

@@ -19,26 +19,40 @@ def test_run_writes_summary_timeseries_and_fields(tmp_path):
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["status"] == "finished"
     assert summary["t_end"] == pytest.approx(0.05)
-    for key in ("steps", "newton_iterations", "wall_time_s", "mean_bit_velocity", "rop", "impacts_total"):
+    for key in ("steps", "newton_iterations", "wall_time_s", "mean_bit_velocity", "rop", "impacts_total",
+                "efficiency", "signed_rop", "stick_slip", "bit_bounce"):
         assert key in summary
+    assert 0.0 <= summary["efficiency"] <= 1.0  # (96) with positive parts: output cannot exceed input
+    assert 0.0 <= summary["max_von_mises"]["t"] <= 0.05 and 0.0 <= summary["max_von_mises"]["x"] <= 10.0
     assert set(summary["energy"]) >= {"input_work", "kinetic", "strain", "dissipated", "balance_error"}
     ds = xr.open_dataset(tmp_path / "timeseries.h5", engine="h5netcdf", phony_dims="sort")
-    assert ds.sizes["time"] == summary["steps"]
+    assert ds.sizes["time"] == summary["steps"] + 1  # the initial state and every accepted step
     assert ds["bit_velocity"].attrs["units"] == "m/s"
     assert ds["impacts_per_vertex"].dims == ("vertex_x",)
     # the bit displacement is the integral of the bit velocity (trapezoidal rule of Newmark, gamma ~ 1/2)
-    t = np.concatenate([[0.0], ds["time"].values])
+    t = ds["time"].values
+    assert t[0] == 0.0
     with h5py.File(tmp_path / "timeseries.h5") as f:
         u, v = f["bit_displacement"][()], f["bit_velocity"][()]
-    travel = np.trapezoid(v, t[1:])
+        assert f["modes/frequency"].shape == f["modes/kind"].shape and f["modes/frequency"][-1] > 0
+    travel = np.trapezoid(v, t)
     assert u[-1] - u[0] == pytest.approx(travel, rel=0.05)
     xdmf = (tmp_path / "fields.xdmf").read_text()
     with h5py.File(tmp_path / "fields.h5") as f:
-        assert set(f["Function"]) == {"u", "v", "w", "theta_x", "theta_y", "theta_z"}
+        assert set(f["Function"]) == {"u", "v", "w", "theta_x", "theta_y", "theta_z", "von_mises"}
         snapshots = list(f["Function/w"])
         assert len(snapshots) == 6  # t = 0, 0.01, ..., 0.05
         assert f["Function/w"][snapshots[0]].shape[0] == 11  # P1: one value per vertex
     assert 'Name="w"' in xdmf and 'Name="theta_x"' in xdmf
+    # fenics-drill plot: every figure, the spectra and the animation from the saved files alone
+    assert main(["plot", str(tmp_path)]) == 0
+    for name in ("fig13_static_3d", "fig14_bit_axial", "fig17_section_radial", "fig19_impacts_position",
+                 "fig20_sections", "fig20_3d", "fig21_psd", "fig22_psd", "fig23_psd"):
+        assert (tmp_path / f"{name}.png").stat().st_size > 10_000, name
+    assert (tmp_path / "animation.gif").exists()
+    spectra = json.loads((tmp_path / "spectra.json").read_text())
+    assert set(spectra) == {"bit_velocity", "bit_angular_velocity", "section_w_velocity",
+                            "section_theta_x_velocity", "impacts"}
 
 
 def test_static_writes_sag_and_contact_positions(tmp_path):

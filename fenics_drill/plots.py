@@ -1,0 +1,117 @@
+"""Figures 14-19 and 21-23 of the paper from a saved run (``fenics-drill plot DIR``).
+
+Fig. 14 bit displacement and velocity, Fig. 15 bit rotation and angular velocity,
+Fig. 16 transverse displacement and velocity at the section, Fig. 17 radial
+displacement at the section against the gap, Fig. 18 impacts against time,
+Fig. 19 impacts per vertex, Figs. 21-23 power spectral densities.  Units are
+converted here, at the plotting edge only (mm, m/h, rev, rpm as in the paper).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+M_PER_S_TO_M_PER_H = 3600.0
+RAD_PER_S_TO_RPM = 60.0 / (2.0 * np.pi)
+
+
+def _save(fig, path: Path) -> Path:
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def _panels(count: int, height: float = 3.0):
+    fig, axes = plt.subplots(count, 1, figsize=(8, height * count), sharex=count > 1, squeeze=False)
+    for ax in axes[:, 0]:
+        ax.grid(alpha=0.3)
+    return fig, axes[:, 0]
+
+
+def _time_pair(path, t, top, bottom, labels, title) -> Path:
+    fig, (a, b) = _panels(2)
+    a.plot(t, top, lw=0.8)
+    b.plot(t, bottom, lw=0.6)
+    a.set_ylabel(labels[0])
+    b.set_ylabel(labels[1])
+    b.set_xlabel("time [s]")
+    a.set_title(title)
+    return _save(fig, path)
+
+
+def time_series_figures(data: dict, attrs: dict, out: Path) -> list[Path]:
+    """Figs. 14-19 from the variables of timeseries.h5."""
+    t, x_s, gap = data["time"], float(attrs["section_x"]), float(attrs.get("gap", np.nan))
+    paths = [
+        _time_pair(out / "fig14_bit_axial.png", t, data["bit_displacement"] * 1e3,
+                   data["bit_velocity"] * M_PER_S_TO_M_PER_H, ("bit displacement [mm]", "bit velocity [m/h]"),
+                   "Fig. 14: drill-bit axial motion"),
+        _time_pair(out / "fig15_bit_rotation.png", t, data["bit_rotation"] / (2 * np.pi),
+                   data["bit_angular_velocity"] * RAD_PER_S_TO_RPM, ("bit rotation [rev]", "bit angular velocity [rpm]"),
+                   "Fig. 15: drill-bit rotation"),
+        _time_pair(out / "fig16_section_lateral.png", t, data["section_w"] * 1e3, data["section_w_velocity"],
+                   ("w [mm]", "w velocity [m/s]"), f"Fig. 16: transverse motion in z at x = {x_s:g} m"),
+    ]
+    fig, (ax,) = _panels(1, 3.5)
+    ax.plot(t, np.hypot(data["section_v"], data["section_w"]) * 1e3, lw=0.8, label="radial displacement")
+    if np.isfinite(gap):
+        ax.axhline(gap * 1e3, color="k", ls="--", lw=1, label="borehole gap")
+    ax.set(xlabel="time [s]", ylabel="radial displacement [mm]", title=f"Fig. 17: radial displacement at x = {x_s:g} m")
+    ax.legend(loc="lower right")
+    paths.append(_save(fig, out / "fig17_section_radial.png"))
+    paths.append(_time_pair(out / "fig18_impacts_time.png", t, data["impacts"], data["vertices_in_contact"],
+                            ("impacts per step", "vertices in contact"), "Fig. 18: wall impacts against time"))
+    fig, (ax,) = _panels(1, 3.5)
+    x = data["vertex_x"]
+    ax.bar(x, data["impacts_per_vertex"], width=x[1] - x[0])
+    ax.set(xlabel="x [m]", ylabel="impacts", title="Fig. 19: wall impacts per vertex", xlim=(x[0], x[-1]))
+    paths.append(_save(fig, out / "fig19_impacts_position.png"))
+    return paths
+
+
+def spectra_figures(spectra: dict, out: Path) -> list[Path]:
+    """Figs. 21-23: raw periodogram (magenta) and Savitzky-Golay smoothed PSD (blue), peaks marked."""
+    paths = []
+    for figure in sorted({s["figure"] for s in spectra.values()}):
+        names = [n for n, s in spectra.items() if s["figure"] == figure]
+        fig, axes = _panels(len(names))
+        for ax, name in zip(axes, names):
+            s = spectra[name]
+            ax.plot(s["frequency_hz"], s["psd_db"], color="m", lw=0.4, label="periodogram")
+            ax.plot(s["frequency_hz"], s["smoothed_db"], color="b", lw=1.0, label="Savitzky-Golay")
+            found = s["peaks"]
+            if found:
+                ax.plot([p["frequency_hz"] for p in found], [p["psd_db"] for p in found], "kv", ms=5)
+                text = "\n".join(f"{p['frequency_hz']:.2f} Hz (nearest mode: {p['mode_kind']} "
+                                 f"{p['mode_frequency_hz']:.2f} Hz)" for p in found)
+                ax.text(0.99, 0.96, text, transform=ax.transAxes, ha="right", va="top", fontsize=7,
+                        bbox={"facecolor": "white", "alpha": 0.8, "lw": 0})
+            visible = s["smoothed_db"][s["frequency_hz"] > 1.0]
+            if visible.size and np.ptp(visible) > 0:
+                ax.set_ylim(np.percentile(visible, 1) - 10, visible.max() + 15)
+            ax.set(ylabel=f"PSD [dB/Hz]\nref. 1 {s['psd_unit']}", title=s["label"])
+            ax.legend(loc="lower left", fontsize=7)
+        axes[-1].set_xlabel("frequency [Hz]")
+        fig.suptitle(f"Fig. {figure}: power spectral density")
+        paths.append(_save(fig, out / f"fig{figure}_psd.png"))
+    return paths
+
+
+def spectra_json(spectra: dict) -> dict:
+    """The peaks (and the grid) of each spectrum, for spectra.json."""
+    return {name: {"label": s["label"], "psd_unit": s["psd_unit"], "figure": s["figure"],
+                   "frequency_resolution_hz": float(s["frequency_hz"][1] - s["frequency_hz"][0]),
+                   "nyquist_hz": float(s["frequency_hz"][-1]), "peaks": s["peaks"]}
+            for name, s in spectra.items()}
+
+
+def write_json(path: Path, data: dict) -> None:
+    path.write_text(json.dumps(data, indent=1, default=float))
