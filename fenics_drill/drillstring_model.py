@@ -21,6 +21,7 @@ from fenics_drill.internal_force import internal_force
 from fenics_drill.modal_report import scene_discretization
 from fenics_drill.operators import LinearOperators, assemble_linear
 from fenics_drill.reduced_space import FullSpace, ModalSpace
+from fenics_drill.static_correction import augment, bit_load_responses
 from fenics_drill.wall_contact import WallContact, WallForces
 
 U_FIELD, V_FIELD, W_FIELD, TX_FIELD = 0, 1, 2, 3
@@ -113,9 +114,10 @@ class DrillstringModel:
         return float(u), float(du), float(tx), float(dtx)
 
 
-def solution_space(scene: dict, disc: BeamDiscretization):
+def solution_space(scene: dict, disc: BeamDiscretization, operators: LinearOperators):
     """(space, kept modes, all modes): the modal basis of the scene's reduction rule (Section 6.3),
-    or the full space for 'none'; all modes of the band B (for spectra) either way."""
+    with the static correction for the bit loads if asked, or the full space for 'none'; all
+    modes of the band B (for spectra) either way."""
     from fenics_drill.modal import solve_modes
     from fenics_drill.reduction import select_modes
 
@@ -124,12 +126,15 @@ def solution_space(scene: dict, disc: BeamDiscretization):
     if scene["reduction"]["rule"] == "none":
         return FullSpace(disc.ndofs, disc.support_dofs), None, modes
     basis = modes.select(select_modes(modes, scene["reduction"], p.length, p.longitudinal_wave_speed))
-    return ModalSpace(basis.vectors), basis, modes
+    phi = basis.vectors
+    if scene["reduction"]["static_correction"]:
+        phi = augment(phi, bit_load_responses(disc, operators), operators.mass)
+    return ModalSpace(phi), basis, modes
 
 
 def build_model(scene: dict) -> DrillstringModel:
     """Discretize, solve the modal problem, choose the basis and build the model of a scene."""
     disc = scene_discretization(scene)
     operators = assemble_linear(disc)
-    space, basis, modes = solution_space(scene, disc)
+    space, basis, modes = solution_space(scene, disc, operators)
     return DrillstringModel(scene, disc, space, operators, basis, modes)

@@ -164,6 +164,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "flexural": _band_or_count("flexural f* upper bound ('band') or mode count ('count')"),
         "torsional": _band_or_count("torsional f* upper bound ('band') or mode count ('count')"),
         "axial": _band_or_count("axial f* upper bound ('band') or mode count ('count')"),
+        "static_correction": _flag(
+            "add the static responses to a unit bit force and torque to the modal basis "
+            "(fenics_drill/static_correction.py); false: the paper's pure modal basis", False),
     },
 }
 

@@ -55,9 +55,15 @@ def smooth(db: np.ndarray) -> np.ndarray:
     return signal.savgol_filter(db, window, SMOOTHING_ORDER)
 
 
+#: Local maxima closer than this are one peak (a smoothed PSD wobbles on top of a broad peak) [Hz].
+PEAK_SEPARATION_HZ = 1.0
+
+
 def spectral_peaks(freq: np.ndarray, db: np.ndarray, count: int = 3, min_frequency: float = 0.0) -> list[dict]:
-    """The ``count`` highest local maxima of a PSD in dB above ``min_frequency``, highest first."""
-    index, _ = signal.find_peaks(db)
+    """The ``count`` highest local maxima of a PSD in dB above ``min_frequency``, highest first,
+    at least PEAK_SEPARATION_HZ apart."""
+    distance = max(1, int(round(PEAK_SEPARATION_HZ / (freq[1] - freq[0]))))
+    index, _ = signal.find_peaks(db, distance=distance)
     index = index[freq[index] > min_frequency]
     best = index[np.argsort(db[index])[::-1][:count]]
     return [{"frequency_hz": float(freq[i]), "psd_db": float(db[i])} for i in best]
