@@ -84,6 +84,29 @@ def cmd_run(args) -> int:
     return {"finished": 0, "interrupted": 130}.get(summary["status"], 1)
 
 
+def cmd_mc(args) -> int:
+    """Monte Carlo over the random bit-rock laws; with mpiexec -n P, realisations spread over P ranks."""
+    from fenics_drill.monte_carlo import monte_carlo
+    from fenics_drill.uncertainty import InadmissibleLaw
+
+    scene = load_scene(args.scene, args.overrides)
+    if args.samples < 1:
+        print("fenics-drill: --samples must be >= 1", file=sys.stderr)
+        return 2
+    try:
+        summary = monte_carlo(scene, args.samples, args.out, resume=args.resume, progress=not args.quiet)
+    except (InadmissibleLaw, ValueError) as err:
+        print(f"fenics-drill: {err}", file=sys.stderr)
+        return 2
+    if summary is not None:
+        rop, eff = summary["rop"], summary["efficiency"]
+        print(f"{summary['realisations']} realisations ({summary['failed']} failed), conv_MC "
+              f"{summary['convergence_metric']:.6e}; rop {rop['mean'] * 3600:.2f} m/h "
+              f"[{rop['p2.5'] * 3600:.2f}, {rop['p97.5'] * 3600:.2f}], efficiency {eff['mean']:.1%} "
+              f"[{eff['p2.5']:.1%}, {eff['p97.5']:.1%}] -> {Path(args.out) / 'summary.json'}")
+    return 0
+
+
 def cmd_plot(args) -> int:
     """Figures of a saved run: Figs. 13-23 as PNG, spectra.json, animation.gif."""
     from fenics_drill.run_figures import plot_run
@@ -148,6 +171,12 @@ def build_parser() -> argparse.ArgumentParser:
     _scene_args(p)
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_run)
+    p = sub.add_parser("mc", help="Monte Carlo over the random bit-rock laws (MPI-parallel, resumable)")
+    _scene_args(p)
+    p.add_argument("--samples", type=int, required=True, help="number of realisations N")
+    p.add_argument("--resume", action="store_true", help="continue the study in --out, skipping what is done")
+    p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.set_defaults(func=cmd_mc)
     p = sub.add_parser("plot", help="figures of a saved run (Figs. 13-23), spectra.json, animation.gif")
     p.add_argument("run_dir", help="the --out directory of 'fenics-drill run'")
     p.add_argument("--no-gif", action="store_true", help="skip the animation (the slowest part)")

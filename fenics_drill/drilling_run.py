@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -21,8 +22,8 @@ from fenics_drill.field_output import FieldWriter
 from fenics_drill.simulation import Simulation, StepRecord
 from fenics_drill.static import StaticFailure, solve_static, static_report
 from fenics_drill.step_control import StepTooSmall, nominal_step
+from fenics_drill.step_rows import StepRows
 from fenics_drill.timeseries import TimeSeriesWriter
-from fenics_drill.von_mises import VonMisesProbe
 
 
 def _write_json(path: Path, data: dict) -> None:
@@ -69,55 +70,52 @@ class RunRecorder:
 
     def __init__(self, model: DrillstringModel, scene: dict, out: Path):
         self.model = model
-        disc = model.disc
-        section = int(np.argmin(np.abs(disc.vertex_x - scene["output"]["section"])))
-        self.section_x = float(disc.vertex_x[section])
-        v_rows, w_rows = model.lateral_rows
-        tx_rows = model.space.rows(disc.vertex_dofs(3))
-        self.section_rows = (v_rows[[section]], w_rows[[section]], tx_rows[[section]])
-        self.series = TimeSeriesWriter(out / "timeseries.h5", disc.vertex_x, {
+        self.rows = StepRows(model, scene)
+        self.section_x = self.rows.section_x
+        self.series = TimeSeriesWriter(out / "timeseries.h5", model.disc.vertex_x, {
             "section_x": self.section_x, "gap": model.gap, "scene": json.dumps(scene), "reduced_size": model.size,
         }, model.modes)
-        flags = scene["model"]
-        self.stress = VonMisesProbe(disc, flags["geometric_nonlinearity"], flags["kinematics"]) \
-            if scene["output"]["von_mises"] else None
         self.field_interval = scene["output"]["field_interval"]
-        self.fields = FieldWriter(disc, out / "fields.xdmf", with_stress=self.stress is not None) \
+        self.fields = FieldWriter(model.disc, out / "fields.xdmf", with_stress=self.rows.stress is not None) \
             if self.field_interval > 0 else None
         self.next_field_time = 0.0
 
     def _write_fields(self, t: float, dofs: np.ndarray) -> None:
         if self.fields is not None and t >= self.next_field_time - 1e-12:
-            stress = self.stress.cell_stress(dofs) if self.stress is not None else None
+            stress = self.rows.stress.cell_stress(dofs) if self.rows.stress is not None else None
             self.fields.write(dofs, t, stress)
             self.next_field_time = self.field_interval * (np.floor(t / self.field_interval + 1e-9) + 1)
 
     def __call__(self, record: StepRecord) -> None:
-        s = record.state
-        u, du, tx, dtx = self.model.bit_state(s.q, s.qd)
-        bit = record.evaluation.bit
-        v, w, _ = (float((rows @ s.q)[0]) for rows in self.section_rows)
-        dv, dw, dsx = (float((rows @ s.qd)[0]) for rows in self.section_rows)
-        dofs = self.model.space.expand(s.q)
-        stress, stress_x = self.stress.maximum(dofs) if self.stress is not None else (np.nan, np.nan)
-        budget = record.budget
-        self.series.append({
-            "time": s.t, "dt": record.dt, "newton_iterations": record.newton_iterations,
-            "bit_displacement": u, "bit_velocity": du, "bit_rotation": tx, "bit_angular_velocity": dtx,
-            "bit_force": 0.0 if bit is None else bit.force, "bit_torque": 0.0 if bit is None else bit.torque,
-            "lambda_1": s.mu[0], "lambda_4": s.mu[1],
-            "impacts": int(record.onsets.sum()), "vertices_in_contact": int(record.in_contact.sum()),
-            "section_v": v, "section_w": w, "section_v_velocity": dv, "section_w_velocity": dw,
-            "section_theta_x_velocity": dsx, "max_von_mises": stress, "max_von_mises_x": stress_x,
-            "kinetic_energy": budget.kinetic, "strain_energy": budget.strain,
-            "input_work": budget.input_work, "dissipated_energy": budget.total_dissipated,
-        })
-        self._write_fields(s.t, dofs)
+        dofs = self.model.space.expand(record.state.q)
+        self.series.append(self.rows(record, dofs))
+        self._write_fields(record.state.t, dofs)
 
     def close(self, impacts_per_vertex: np.ndarray) -> None:
         self.series.close(impacts_per_vertex)
         if self.fields is not None:
             self.fields.close()
+
+
+@dataclass
+class PreparedScene:
+    """What every drilling run of a scene shares: the model and its static equilibrium (Section 6.4).
+    Neither depends on the drive speeds nor on the bit-rock parameters."""
+
+    model: DrillstringModel
+    equilibrium: object
+    static: dict
+    setup_time_s: float
+
+
+def prepare(scene: dict) -> PreparedScene:
+    """Build the model and solve its static equilibrium (raises StaticFailure)."""
+    clock = time.perf_counter()
+    model = build_model(scene)
+    setup = time.perf_counter() - clock
+    equilibrium = solve_static(model)
+    static = {k: v for k, v in static_report(model, equilibrium).items() if k != "contact_vertices"}
+    return PreparedScene(model, equilibrium, static, setup)
 
 
 def run_scene(scene: dict, out: str | Path, progress: bool = True) -> dict:
@@ -128,11 +126,10 @@ def run_scene(scene: dict, out: str | Path, progress: bool = True) -> dict:
     summary: dict = {"status": "failed", "message": "", "t_end": 0.0, "steps": 0}
     recorder = simulation = None
     try:
-        model = build_model(scene)
+        prepared = prepare(scene)
+        model, equilibrium = prepared.model, prepared.equilibrium
         summary["reduced_size"], summary["full_dofs"] = model.size, model.disc.ndofs
-        summary["setup_time_s"] = time.perf_counter() - clock
-        equilibrium = solve_static(model)
-        summary["static"] = {k: v for k, v in static_report(model, equilibrium).items() if k != "contact_vertices"}
+        summary["setup_time_s"], summary["static"] = prepared.setup_time_s, prepared.static
         simulation = Simulation(model, scene)
         start = simulation.initial_state(equilibrium.q, equilibrium.mu)
         recorder = RunRecorder(model, scene, out)

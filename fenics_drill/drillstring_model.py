@@ -54,6 +54,7 @@ class DrillstringModel:
         self.internal = internal_force(disc, space, operators, model)
         self.gravity = space.project(operators.gravity) if model["gravity"] else None
         self.wall = WallContact(disc, space, scene["contact"], borehole_radius) if model["contact"] else None
+        self.borehole_radius = borehole_radius
         self.bit = BitRock(disc, space, scene["bit_rock"], borehole_radius) if model["bit_rock"] else None
         drive_dofs = [disc.end_dof(U_FIELD, 0), disc.end_dof(TX_FIELD, 0)]
         rows = space.rows(drive_dofs)
@@ -66,6 +67,15 @@ class DrillstringModel:
     @property
     def size(self) -> int:
         return self.space.size
+
+    def set_bit_rock(self, bit_rock: dict) -> None:
+        """New bit-rock parameters (a Monte Carlo realisation); nothing else depends on them."""
+        if self.bit is not None:
+            self.bit = BitRock(self.disc, self.space, bit_rock, self.borehole_radius)
+
+    def set_drive(self, axial_velocity: float, rotation_speed: float) -> None:
+        """New drive speeds V0, Omega (a point of an operating window); nothing else depends on them."""
+        self.drive_rate = np.array([axial_velocity, rotation_speed])
 
     def drive_velocity_field(self) -> np.ndarray:
         """Initial velocity of Section 3.2 in reduced coordinates: u_dot = V0, theta_x_dot = Omega,

@@ -90,10 +90,16 @@ def _tube_scene(plotter, snap: FieldSnapshots, k: int, geo: dict, clim=None):
     plotter.camera.zoom(1.6)
 
 
-def picture_3d(snap: FieldSnapshots, k: int, geo: dict, path: Path, title: str) -> Path:
+def _plotter(window_size):
+    """An off-screen PyVista plotter; VTK's complaint about the missing X display is silenced."""
     import pyvista as pv
 
-    plotter = pv.Plotter(off_screen=True, window_size=(1400, 600))
+    pv.vtk_verbosity("off")
+    return pv.Plotter(off_screen=True, window_size=window_size)
+
+
+def picture_3d(snap: FieldSnapshots, k: int, geo: dict, path: Path, title: str) -> Path:
+    plotter = _plotter((1400, 600))
     _tube_scene(plotter, snap, k, geo)
     plotter.add_text(f"{title}\n(axial axis compressed to {AXIAL_DIAMETERS:g} borehole diameters)", font_size=10)
     plotter.screenshot(str(path))
@@ -103,12 +109,10 @@ def picture_3d(snap: FieldSnapshots, k: int, geo: dict, path: Path, title: str) 
 
 def animation(snap: FieldSnapshots, geo: dict, path: Path) -> Path:
     """The 3D view at every snapshot, as a GIF (colour scale fixed over the run)."""
-    import pyvista as pv
-
     clim = None
     if "von_mises" in snap.cell_fields:
         clim = (0.0, float(snap.cell_fields["von_mises"].max()) / 1e6)
-    plotter = pv.Plotter(off_screen=True, window_size=(1000, 450))
+    plotter = _plotter((1000, 450))
     plotter.open_gif(str(path), fps=10)
     for k, t in enumerate(snap.times):
         plotter.clear()

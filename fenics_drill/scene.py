@@ -47,6 +47,10 @@ def _pos(doc: str, default, kind=float) -> Key:
     return Key(kind, default, doc, _positive, "> 0")
 
 
+def _gamma_dispersion(x: float) -> bool:
+    return 0.0 <= x < 1.0 / math.sqrt(2.0)
+
+
 def _nonneg(doc: str, default, kind=float) -> Key:
     return Key(kind, default, doc, _non_negative, ">= 0")
 
@@ -167,6 +171,17 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "static_correction": _flag(
             "add the static responses to a unit bit force and torque to the modal basis "
             "(fenics_drill/static_correction.py); false: the paper's pure modal basis", False),
+    },
+    "uncertainty": {  # Section 5 and 6.11; the means are the bit_rock values
+        "rate_dispersion": Key(float, 0.005, "dispersion sigma/m of alpha_BR, gamma law (81) [-]",
+                               _gamma_dispersion, "in [0, 1/sqrt(2)) (Eq. 81)"),
+        "limit_force_dispersion": Key(float, 0.01, "dispersion sigma/m of Gamma_BR, gamma law (86) [-]",
+                                      _gamma_dispersion, "in [0, 1/sqrt(2)) (Eq. 86)"),
+        "friction_dispersion": _nonneg(
+            "dispersion sigma/m of mu_BR, beta law (90)-(92); with mean m it must be < sqrt((1 - m)/m) [-]", 0.005),
+        "seed": Key(int, 20150101, "base seed: realisation k draws from numpy default_rng([seed, k])",
+                    lambda n: n >= 0, ">= 0"),
+        "output_interval": _pos("step of the common time grid of the Monte Carlo histories [s]", 0.01),
     },
 }
 
