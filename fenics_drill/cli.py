@@ -107,17 +107,48 @@ def cmd_mc(args) -> int:
     return 0
 
 
-def cmd_plot(args) -> int:
-    """Figures of a saved run: Figs. 13-23 as PNG, spectra.json, animation.gif."""
-    from fenics_drill.run_figures import plot_run
+def cmd_optimize(args) -> int:
+    """The operating window: deterministic or robust optimum of rop or efficiency under the von Mises limit."""
+    from fenics_drill.optimize import run_optimize
+    from fenics_drill.uncertainty import InadmissibleLaw
 
-    run_dir = Path(args.run_dir)
-    if not (run_dir / "timeseries.h5").exists():
-        print(f"fenics-drill: {run_dir} holds no timeseries.h5 (is it the --out of 'fenics-drill run'?)",
-              file=sys.stderr)
+    scene = load_scene(args.scene, args.overrides)
+    try:
+        report = run_optimize(scene, args.out, resume=args.resume, progress=not args.quiet)
+    except (InadmissibleLaw, ValueError) as err:
+        print(f"fenics-drill: {err}", file=sys.stderr)
         return 2
-    paths = plot_run(run_dir, gif=not args.no_gif)
-    print(f"{len(paths)} files in {run_dir}: " + ", ".join(p.name for p in paths))
+    if report is not None:
+        if report["feasible"]:
+            o = report["optimum"]
+            print(f"{report['mode']} optimum of {report['objective']}: V0 = {o['axial_velocity'] * 3600:.2f} m/h, "
+                  f"Omega = {o['rotation_speed'] * 30 / 3.141592653589793:.1f} rpm, objective {o['objective']:.6g} "
+                  f"-> {Path(args.out) / 'optimize.json'}")
+        else:
+            print(f"infeasible: {report['message']} -> {Path(args.out) / 'optimize.json'}")
+    return 0
+
+
+def cmd_plot(args) -> int:
+    """Figures of a saved run (Figs. 13-23) or Monte Carlo study (Figs. 28-35)."""
+    directory = Path(args.run_dir)
+    if (directory / "optimize.json").exists():
+        from fenics_drill.optimize_plots import optimize_figures
+
+        paths = optimize_figures(directory)
+    elif (directory / "statistics.h5").exists():
+        from fenics_drill.mc_plots import mc_figures
+
+        paths = mc_figures(directory)
+    elif (directory / "timeseries.h5").exists():
+        from fenics_drill.run_figures import plot_run
+
+        paths = plot_run(directory, gif=not args.no_gif)
+    else:
+        print(f"fenics-drill: {directory} holds no timeseries.h5 ('fenics-drill run'), statistics.h5 "
+              "('fenics-drill mc') or optimize.json ('fenics-drill optimize')", file=sys.stderr)
+        return 2
+    print(f"{len(paths)} files in {directory}: " + ", ".join(p.name for p in paths))
     return 0
 
 
@@ -177,8 +208,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true", help="continue the study in --out, skipping what is done")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_mc)
-    p = sub.add_parser("plot", help="figures of a saved run (Figs. 13-23), spectra.json, animation.gif")
-    p.add_argument("run_dir", help="the --out directory of 'fenics-drill run'")
+    p = sub.add_parser("optimize", help="efficiency / rop over the operating window, deterministic or robust "
+                                        "(MPI-parallel, resumable): DIR/optimize.json")
+    _scene_args(p)
+    p.add_argument("--resume", action="store_true", help="continue in --out, skipping the points done")
+    p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.set_defaults(func=cmd_optimize)
+    p = sub.add_parser("plot", help="figures of a run (Figs. 13-23, spectra.json, animation.gif) or of a "
+                                    "Monte Carlo study (Figs. 28-35)")
+    p.add_argument("run_dir", help="the --out directory of 'fenics-drill run' or 'fenics-drill mc'")
     p.add_argument("--no-gif", action="store_true", help="skip the animation (the slowest part)")
     p.set_defaults(func=cmd_plot)
     p = sub.add_parser("forms", help="list/show the weak forms, or check the printed ones against the energies")

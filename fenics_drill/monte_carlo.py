@@ -63,8 +63,10 @@ class RealisationRecorder:
 
 
 def run_realisation(prepared: PreparedScene, scene: dict, bit_rock: dict) -> dict:
-    """One drilling run from the shared static state with the given bit-rock parameters."""
+    """One drilling run from the shared static state with the scene's drive speeds and the given
+    bit-rock parameters."""
     model = prepared.model
+    model.set_drive(scene["drive"]["axial_velocity"], scene["drive"]["rotation_speed"])
     model.set_bit_rock(bit_rock)
     simulation = Simulation(model, scene)
     start = simulation.initial_state(prepared.equilibrium.q, prepared.equilibrium.mu)

@@ -55,6 +55,14 @@ def _nonneg(doc: str, default, kind=float) -> Key:
     return Key(kind, default, doc, _non_negative, ">= 0")
 
 
+def _grid_axis(x) -> bool:
+    """[min, max, n]: 0 <= min <= max and n a whole number >= 1 (n = 1 needs min = max)."""
+    if not isinstance(x, list) or len(x) != 3 or not all(isinstance(v, (int, float)) for v in x):
+        return False
+    low, high, n = x
+    return 0 <= low <= high and float(n).is_integer() and n >= 1 and (n > 1 or low == high)
+
+
 def _flag(doc: str, default: bool = True) -> Key:
     return Key(bool, default, doc)
 
@@ -182,6 +190,19 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "seed": Key(int, 20150101, "base seed: realisation k draws from numpy default_rng([seed, k])",
                     lambda n: n >= 0, ">= 0"),
         "output_interval": _pos("step of the common time grid of the Monte Carlo histories [s]", 0.01),
+    },
+    "optimize": {  # Sections 6.9, 6.10, 6.12: the operating window and the objective
+        "axial_velocity": Key(list, [1.0 / 360.0, 1.0 / 90.0, 4], "grid of V0: [min, max, points] [m/s]",
+                              _grid_axis, "[min, max, n] with 0 <= min <= max and n >= 1 whole"),
+        "rotation_speed": Key(list, [1.5 * math.pi, 7.0 * math.pi / 3.0, 4], "grid of Omega: [min, max, points] "
+                              "[rad/s]", _grid_axis, "[min, max, n] with 0 <= min <= max and n >= 1 whole"),
+        "objective": Key(str, "rop", "what to maximise: 'rop' (99) or 'efficiency' (96)",
+                         choices=("rop", "efficiency")),
+        "ultimate_strength": _pos("UTS of the von Mises constraint (100), (103) [Pa]", 650e6),
+        "samples": Key(int, 0, "realisations per grid point: 0 = deterministic (nominal bit-rock), "
+                       "N > 0 = robust, E[objective] (102) under the chance constraint (103)-(104)",
+                       _non_negative, ">= 0"),
+        "risk": Key(float, 0.1, "P_risk of the chance constraint (104) [-]", lambda x: 0 < x < 1, "in (0, 1)"),
     },
 }
 

@@ -107,6 +107,11 @@ def test_serial_study_writes_statistics_and_the_summary(serial_study):
     # a KDE is a density: it integrates to 1 over its support (3 deviations of margin on each side)
     pdf = stats["pdf/rop/density"], stats["pdf/rop/points"]
     assert np.trapezoid(*pdf) == pytest.approx(1.0, abs=1e-2)
+    assert main(["plot", str(serial_study)]) == 0
+    for stem in ("fig28_convergence", "fig29_bit_axial_envelope", "fig30_pdf_bit_velocity_at_t_end",
+                 "fig31_bit_rotation_envelope", "fig33_section_lateral_envelope", "fig34_pdf_efficiency",
+                 "fig35_pdf_rop"):
+        assert (serial_study / f"{stem}.png").stat().st_size > 10_000, stem
 
 
 @pytest.mark.skipif(not MPIEXEC.exists(), reason="no mpiexec next to the interpreter")
