@@ -31,10 +31,10 @@ def convergence_metric(q_norm_integrals: np.ndarray) -> np.ndarray:
 
 def kde(values: np.ndarray, normalised: bool = False) -> tuple[np.ndarray, np.ndarray] | None:
     """(points, density) of a Gaussian KDE; standardised to zero mean, unit deviation if asked.
-    None when the values do not spread (fewer than 2, or all equal)."""
+    None when the values do not spread (fewer than 2, or equal to round-off: zero dispersions)."""
     values = np.asarray(values, dtype=float)
     values = values[np.isfinite(values)]
-    if len(values) < 2 or np.std(values) == 0:
+    if len(values) < 2 or np.std(values) <= 1e-12 * np.max(np.abs(values)):
         return None
     if normalised:
         values = (values - values.mean()) / values.std()

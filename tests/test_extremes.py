@@ -1,0 +1,97 @@
+"""Stability at the extremes (issue 8): short scenes at the edges of every knob.  Each run either
+finishes with finite outputs and an energy that never exceeds what the drive put in, or stops
+with a message naming when and why.  None may hang: each has a wall-clock alarm."""
+
+import json
+import math
+import signal
+
+import h5py
+import numpy as np
+import pytest
+
+from fenics_drill.cli import main
+
+BASE = ["--set", "beam.length=10.0", "--set", "beam.elements=10", "--set", "time.t_end=0.05",
+        "--set", "output.field_interval=0.025", "--set", "reduction.rule='count'",
+        "--set", "reduction.flexural=6", "--set", "reduction.torsional=2", "--set", "reduction.axial=2"]
+NOMINAL_DT_10M = 1.0 / (2 * 4.0 * math.sqrt(203e9 / 7900.0) / 10.0)  # 1/(2 f_max), f_max = 4 c_L/L, c_L = sqrt(E/rho)
+#: Seconds of wall time after which a case counts as hung (a case takes about 2 s).
+ALARM_S = 120
+
+#: A 20 m string sags onto the wall (a 10 m one does not: its sag is below the 15 mm gap).
+ON_WALL = ["beam.length=20.0", "beam.elements=20"]
+
+EXTREMES = {
+    "newmark alpha = 0": ["time.newmark_alpha=0.0"],
+    "newmark alpha = 0.5": ["time.newmark_alpha=0.5"],
+    "dt = nominal, fixed": ["time.adaptive=false"],
+    "dt = 8 x nominal, fixed": ["time.adaptive=false", f"time.dt={8 * NOMINAL_DT_10M}"],
+    "dt = 8 x nominal, adaptive": [f"time.dt={8 * NOMINAL_DT_10M}"],
+    "on the wall (L = 20 m)": ON_WALL,
+    "on the wall, stiffness x 100": [*ON_WALL, "contact.stiffness_linear=1e12", "contact.stiffness_cubic=1e18"],
+    "on the wall, stiffness x 0.01": [*ON_WALL, "contact.stiffness_linear=1e8", "contact.stiffness_cubic=1e14"],
+    "on the wall, Omega x 5": [*ON_WALL, "drive.rotation_speed=31.41592653589793"],
+    "Omega x 5": ["drive.rotation_speed=31.41592653589793"],
+    "Omega = 0": ["drive.rotation_speed=0.0"],
+    "V0 = 0": ["drive.axial_velocity=0.0"],
+    "L = 1000 m (slenderness 12500)": ["beam.length=1000.0", "beam.elements=100", "time.t_end=0.5",
+                                       "output.field_interval=0.25"],
+    "stubby: L = 2 m (slenderness 25)": ["beam.length=2.0", "beam.elements=10"],
+    "no damping, no friction": ["beam.damping=0.0", "contact.friction=0.0", "bit_rock.friction=0.0"],
+    "printed kinematics": ["model.kinematics='printed'"],
+}
+
+
+@pytest.fixture
+def alarm():
+    def hung(signum, frame):
+        raise TimeoutError(f"the case ran for more than {ALARM_S} s")
+
+    previous = signal.signal(signal.SIGALRM, hung)
+    signal.alarm(ALARM_S)
+    yield
+    signal.alarm(0)
+    signal.signal(signal.SIGALRM, previous)
+
+
+@pytest.mark.parametrize("case", list(EXTREMES))
+def test_extreme_scene_finishes_sanely_or_stops_with_a_reason(case, tmp_path, alarm):
+    overrides = [item for o in EXTREMES[case] for item in ("--set", o)]
+    code = main(["run", *BASE, *overrides, "--quiet", "--out", str(tmp_path)])
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    if code != 0:
+        assert summary["status"] == "failed" and summary["message"].startswith("at t = "), summary["message"]
+        return
+    assert summary["status"] == "finished"
+    with h5py.File(tmp_path / "timeseries.h5", "r") as f:
+        for name, dataset in f.items():
+            if isinstance(dataset, h5py.Dataset) and name not in ("max_von_mises", "max_von_mises_x"):
+                assert np.isfinite(dataset[()]).all(), name
+        assert np.isfinite(f["max_von_mises"][()]).all()
+    with h5py.File(tmp_path / "fields.h5", "r") as f:
+        f.visititems(lambda name, obj: None if not isinstance(obj, h5py.Dataset) else
+                     np.testing.assert_array_equal(np.isfinite(obj[()]), True, err_msg=name))
+    energy = summary["energy"]
+    assert all(np.isfinite(v) for v in energy.values() if isinstance(v, float))
+    # the wall, the bit, the dampers and Newmark's alpha only take energy out: the mechanical energy
+    # cannot grow by more than the drive's work (1e-6 of the largest exchange for the quadrature)
+    scale = max(abs(energy["input_work"]), energy["dissipated"], energy["kinetic"], 1e-12)
+    assert energy["energy_change"] <= energy["input_work"] + 1e-6 * scale
+    if case == "newmark alpha = 0":
+        assert energy["balance_error"] < 1e-2  # no numerical dissipation: the budget closes
+
+
+@pytest.mark.parametrize("dispersions", [(0.7, 0.7, 1.2), (0.0, 0.0, 0.0)])
+def test_dispersions_at_the_edges_of_their_laws_run_or_are_refused(dispersions, tmp_path, alarm):
+    """Gamma dispersions just below 1/sqrt(2) and a beta dispersion just below sqrt((1-m)/m) = 1.2247
+    for m = 0.4 are admissible and must run; zero dispersion is the nominal model."""
+    rate, limit, friction = dispersions
+    overrides = ["--set", f"uncertainty.rate_dispersion={rate}", "--set", f"uncertainty.limit_force_dispersion={limit}",
+                 "--set", f"uncertainty.friction_dispersion={friction}", "--set", "uncertainty.output_interval=0.01"]
+    assert main(["mc", *BASE, *overrides, "--samples", "3", "--quiet", "--out", str(tmp_path)]) == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["realisations"] + summary["failed"] == 3
+    if dispersions == (0.0, 0.0, 0.0):
+        assert summary["rop"]["std"] <= 1e-12 * summary["rop"]["mean"]
+        assert summary["rop"]["mean"] == pytest.approx(summary["nominal"]["rop"], rel=1e-12)
