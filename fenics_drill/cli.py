@@ -81,6 +81,8 @@ def cmd_run(args) -> int:
             f"mean bit velocity {summary['mean_bit_velocity'] * 3600:.2f} m/h, rop {summary['rop'] * 3600:.2f} m/h, "
             f"impacts {summary['impacts_total']}, energy balance error {summary['energy']['balance_error']:.2e}"
         )
+    for advice in summary.get("advice", []):
+        print(f"note: {advice}")
     return {"finished": 0, "interrupted": 130}.get(summary["status"], 1)
 
 

@@ -179,8 +179,9 @@ def _dynamics_summary(model, simulation: Simulation, recorder: RunRecorder, stat
 
 
 def _observables(series_path: Path) -> dict:
-    """Drilling quantities (96)-(99), indicators and the von Mises maximum (100) of the saved series."""
-    data, _ = read_series(series_path)
+    """Drilling quantities (96)-(99), indicators and the von Mises maximum (100) of the saved series,
+    and ``advice`` on physics the scene paid for without needing it."""
+    data, attrs = read_series(series_path)
     if len(data["time"]) < 2:
         return {}
     out = from_timeseries(series_path)
@@ -189,4 +190,10 @@ def _observables(series_path: Path) -> dict:
         k = int(np.nanargmax(stress))
         out["max_von_mises"] = {"value": float(stress[k]), "x": float(data["max_von_mises_x"][k]),
                                 "t": float(data["time"][k])}
+    advice = []
+    if json.loads(attrs["scene"])["model"]["contact"] and not data["vertices_in_contact"].any():
+        advice.append("the string never touched the wall: model.contact = false gives the same answer "
+                      "without paying for contact")
+    if advice:
+        out["advice"] = advice
     return out

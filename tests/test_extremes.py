@@ -95,3 +95,19 @@ def test_dispersions_at_the_edges_of_their_laws_run_or_are_refused(dispersions, 
     if dispersions == (0.0, 0.0, 0.0):
         assert summary["rop"]["std"] <= 1e-12 * summary["rop"]["mean"]
         assert summary["rop"]["mean"] == pytest.approx(summary["nominal"]["rop"], rel=1e-12)
+
+
+def test_a_scene_that_never_touches_the_wall_is_told_contact_is_not_needed(tmp_path):
+    """The 10 m string never reaches the wall: the run says so, and without contact the answer is the same."""
+    results = {}
+    for contact in ("true", "false"):
+        out = tmp_path / contact
+        assert main(["run", *BASE, "--set", f"model.contact={contact}", "--quiet", "--out", str(out)]) == 0
+        results[contact] = json.loads((out / "summary.json").read_text())
+    assert "model.contact = false" in results["true"]["advice"][0]
+    assert "advice" not in results["false"]
+    for key in ("rop", "efficiency", "mean_bit_velocity"):
+        assert results["false"][key] == pytest.approx(results["true"][key], rel=1e-12), key
+    on_wall = tmp_path / "wall"
+    assert main(["run", *BASE, *[i for o in ON_WALL for i in ("--set", o)], "--quiet", "--out", str(on_wall)]) == 0
+    assert "advice" not in json.loads((on_wall / "summary.json").read_text())
