@@ -2,7 +2,7 @@
 PY := .venv/bin/python
 OUT ?= out
 
-.PHONY: setup demo demo-printed test bench clean
+.PHONY: setup demo demo-printed test bench mc optimize clean
 
 setup:
 	@bash scripts/bootstrap.sh
@@ -29,6 +29,23 @@ test: setup
 bench: setup
 	$(PY) benchmarks/modal_timing.py
 	$(PY) benchmarks/dynamics_convergence.py
+	$(PY) benchmarks/tradeoff.py demos/scenes/paper.toml --t-end 0.5
+
+## The paper's Monte Carlo study (Section 6.11) at SAMPLES realisations on RANKS processes.
+SAMPLES ?= 32
+RANKS ?= 2
+mc: setup
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli mc demos/scenes/paper.toml --samples $(SAMPLES) --out $(OUT)/mc --resume
+	$(PY) -m fenics_drill.cli plot $(OUT)/mc
+
+## The paper's operating windows (Sections 6.9, 6.10, 6.12) at the resolution of demos/scenes/window*.toml.
+optimize: setup
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/window_rop.toml --out $(OUT)/window-rop --resume
+	$(PY) -m fenics_drill.cli plot $(OUT)/window-rop
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/window_efficiency.toml --out $(OUT)/window-efficiency --resume
+	$(PY) -m fenics_drill.cli plot $(OUT)/window-efficiency
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/window_robust.toml --out $(OUT)/window-robust --resume
+	$(PY) -m fenics_drill.cli plot $(OUT)/window-robust
 
 clean:
 	rm -rf $(OUT) .pytest_cache

@@ -41,7 +41,9 @@ def mc_figures(study: Path) -> list[Path]:
         n = int(f.attrs["realisations"])
         fig, (ax,) = _panels(1, 3.5)
         ax.plot(np.arange(1, n + 1), f["convergence_metric"][()], "b-", lw=1)
-        ax.set(xlabel="number of realisations", ylabel="conv_MC [-]", title="Fig. 28: convergence metric (101)")
+        ax.ticklabel_format(axis="y", useOffset=False)
+        ax.set(xlabel="number of realisations", ylabel="conv_MC [kg^1/2 m s^1/2]",
+               title="Fig. 28: convergence metric (101) of the M-normalised modal coordinates")
         paths.append(_save(fig, study / "fig28_convergence.png"))
         t = f["time"][()]
         for figure, stem, rows, title in ENVELOPES:
@@ -62,6 +64,8 @@ def mc_figures(study: Path) -> list[Path]:
             g = f["pdf"][name]
             fig, (ax,) = _panels(1, 3.5)
             ax.plot(g["points"][()] * scale, g["density"][()] / scale, "b-")
-            ax.set(xlabel=xlabel, ylabel="probability density", title=f"Fig. {figure}: PDF ({n} realisations, KDE)")
+            unit = xlabel[xlabel.rindex("[") + 1:-1]
+            ax.set(xlabel=xlabel, ylabel=f"probability density [1/{unit}]" if unit != "-" else "probability density [-]",
+                   title=f"Fig. {figure}: PDF ({n} realisations, Gaussian KDE)")
             paths.append(_save(fig, study / f"fig{figure}_pdf_{name}.png"))
     return paths

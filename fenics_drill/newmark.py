@@ -38,16 +38,15 @@ def newmark_parameters(alpha: float) -> tuple[float, float]:
     return gamma, 0.25 * (0.5 + gamma) ** 2
 
 
-#: Steps over which an assembled internal tangent is reused (the displacements are small,
-#: so it changes slowly; contact and bit-rock tangents are recomputed at every iteration).
-TANGENT_REUSE_STEPS = 20
-
-
 class NewmarkNewton:
     """One Newmark step of (65) with the constraints (72) enforced by multipliers."""
 
-    def __init__(self, model: DrillstringModel, alpha: float, tolerance: float, max_iterations: int):
+    def __init__(self, model: DrillstringModel, alpha: float, tolerance: float, max_iterations: int,
+                 tangent_reuse: int = 20):
+        """``tangent_reuse``: steps over which an assembled internal tangent is kept (the displacements
+        are small, so it changes slowly; contact and bit-rock tangents are fresh at every iteration)."""
         self.model = model
+        self.tangent_reuse = tangent_reuse
         self.gamma, self.beta = newmark_parameters(alpha)
         self.tolerance, self.max_iterations = tolerance, max_iterations
         self._internal_parts = None
@@ -97,7 +96,7 @@ class NewmarkNewton:
 
         q = state.q + dt * state.qd + 0.5 * dt * dt * state.qdd
         mu = state.mu.copy()
-        stale = self._internal_parts is None or self._steps_since_tangent >= TANGENT_REUSE_STEPS
+        stale = self._internal_parts is None or self._steps_since_tangent >= self.tangent_reuse
         qd, qdd, ev = evaluate(q, mu, stale and self.model.internal.state_dependent)
         norm = np.linalg.norm(ev.residual)
         # forces can balance to round-off (e.g. M qdd + K q in free vibration): also measure

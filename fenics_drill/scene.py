@@ -135,6 +135,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "solver": {
         "newton_tolerance": _pos("relative residual at which Newton stops [-]", 1e-8),
         "newton_max_iterations": Key(int, 25, "Newton iterations before the step is cut [-]", _positive, ">= 1"),
+        "tangent_reuse": Key(int, 20, "steps over which the assembled internal tangent is reused; 1: fresh at "
+                             "every step (contact and bit tangents are always fresh) [-]", _positive, ">= 1"),
     },
     "output": {
         "section": Key(
