@@ -147,7 +147,7 @@ def test_eigenvalue_convergence_rate(degree, rate):
 
 @pytest.fixture(scope="module")
 def paper_report():
-    return modal_report(scene_with())
+    return modal_report(scene_with("beam.elements=500"))  # the paper's mesh (Section 6)
 
 
 def test_paper_flexural_frequencies_of_section_6_8(paper_report):
