@@ -13,7 +13,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from fenics_drill.plots import M_PER_S_TO_M_PER_H, RAD_PER_S_TO_RPM, _panels, _save
+from fenics_drill.plots import M_PER_S_TO_M_PER_H, RAD_PER_S_TO_RPM, panels, save_figure
 
 #: (figure, file stem, [(history, scale, label), (history, scale, label)], title)
 ENVELOPES = (
@@ -39,15 +39,15 @@ def mc_figures(study: Path) -> list[Path]:
     paths = []
     with h5py.File(study / "statistics.h5", "r") as f:
         n = int(f.attrs["realisations"])
-        fig, (ax,) = _panels(1, 3.5)
+        fig, (ax,) = panels(1, 3.5)
         ax.plot(np.arange(1, n + 1), f["convergence_metric"][()], "b-", lw=1)
         ax.ticklabel_format(axis="y", useOffset=False)
         ax.set(xlabel="number of realisations", ylabel="conv_MC [kg^1/2 m s^1/2]",
                title="Fig. 28: convergence metric (101) of the M-normalised modal coordinates")
-        paths.append(_save(fig, study / "fig28_convergence.png"))
+        paths.append(save_figure(fig, study / "fig28_convergence.png"))
         t = f["time"][()]
         for figure, stem, rows, title in ENVELOPES:
-            fig, axes = _panels(2)
+            fig, axes = panels(2)
             for ax, (name, scale, label) in zip(axes, rows):
                 g = f[name]
                 ax.fill_between(t, g["p2.5"][()] * scale, g["p97.5"][()] * scale, color="0.75", label="95 % envelope")
@@ -57,15 +57,15 @@ def mc_figures(study: Path) -> list[Path]:
             axes[0].legend(loc="best", fontsize=8)
             axes[0].set_title(f"Fig. {figure}: {title} ({n} realisations)")
             axes[-1].set_xlabel("time [s]")
-            paths.append(_save(fig, study / f"fig{figure}_{stem}_envelope.png"))
+            paths.append(save_figure(fig, study / f"fig{figure}_{stem}_envelope.png"))
         for figure, name, xlabel, scale in PDFS:
             if name not in f["pdf"]:
                 continue  # no spread (all realisations equal)
             g = f["pdf"][name]
-            fig, (ax,) = _panels(1, 3.5)
+            fig, (ax,) = panels(1, 3.5)
             ax.plot(g["points"][()] * scale, g["density"][()] / scale, "b-")
             unit = xlabel[xlabel.rindex("[") + 1:-1]
             ax.set(xlabel=xlabel, ylabel=f"probability density [1/{unit}]" if unit != "-" else "probability density [-]",
                    title=f"Fig. {figure}: PDF ({n} realisations, Gaussian KDE)")
-            paths.append(_save(fig, study / f"fig{figure}_pdf_{name}.png"))
+            paths.append(save_figure(fig, study / f"fig{figure}_pdf_{name}.png"))
     return paths

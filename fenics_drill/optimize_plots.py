@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fenics_drill.plots import M_PER_S_TO_M_PER_H, RAD_PER_S_TO_RPM, _panels, _save
+from fenics_drill.plots import M_PER_S_TO_M_PER_H, RAD_PER_S_TO_RPM, panels, save_figure
 
 #: map -> (figure in the paper, label, scale)
 MAPS = {
@@ -28,7 +28,7 @@ def optimize_figures(directory: Path) -> list[Path]:
     paths = []
     for name, (figure, label, scale) in MAPS.items():
         values = np.array(report[name], dtype=float) * scale
-        fig, (ax,) = _panels(1, 5.0)
+        fig, (ax,) = panels(1, 5.0)
         if len(v0) > 1 and len(rpm) > 1:
             levels = ax.contourf(v0, rpm, values.T, levels=15, cmap="viridis")
             fig.colorbar(levels, ax=ax, label=("E[" + label + "]") if robust and name != "max_von_mises" else label)
@@ -46,5 +46,5 @@ def optimize_figures(directory: Path) -> list[Path]:
         ax.set(xlabel="V0 [m/h]", ylabel="Omega [rpm]",
                title=f"Fig. {shown}: {label}\n{report['mode']}, t_end = {report['t_end']:g} s")
         ax.legend(loc="lower left", fontsize=7)
-        paths.append(_save(fig, directory / f"fig{shown}_{name}_map.png"))
+        paths.append(save_figure(fig, directory / f"fig{shown}_{name}_map.png"))
     return paths

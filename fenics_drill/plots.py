@@ -22,14 +22,14 @@ M_PER_S_TO_M_PER_H = 3600.0
 RAD_PER_S_TO_RPM = 60.0 / (2.0 * np.pi)
 
 
-def _save(fig, path: Path) -> Path:
+def save_figure(fig, path: Path) -> Path:
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
 
 
-def _panels(count: int, height: float = 3.0):
+def panels(count: int, height: float = 3.0):
     fig, axes = plt.subplots(count, 1, figsize=(8, height * count), sharex=count > 1, squeeze=False)
     for ax in axes[:, 0]:
         ax.grid(alpha=0.3)
@@ -37,14 +37,14 @@ def _panels(count: int, height: float = 3.0):
 
 
 def _time_pair(path, t, top, bottom, labels, title) -> Path:
-    fig, (a, b) = _panels(2)
+    fig, (a, b) = panels(2)
     a.plot(t, top, lw=0.8)
     b.plot(t, bottom, lw=0.6)
     a.set_ylabel(labels[0])
     b.set_ylabel(labels[1])
     b.set_xlabel("time [s]")
     a.set_title(title)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def time_series_figures(data: dict, attrs: dict, out: Path) -> list[Path]:
@@ -60,20 +60,20 @@ def time_series_figures(data: dict, attrs: dict, out: Path) -> list[Path]:
         _time_pair(out / "fig16_section_lateral.png", t, data["section_w"] * 1e3, data["section_w_velocity"],
                    ("w [mm]", "w velocity [m/s]"), f"Fig. 16: transverse motion in z at x = {x_s:g} m"),
     ]
-    fig, (ax,) = _panels(1, 3.5)
+    fig, (ax,) = panels(1, 3.5)
     ax.plot(t, np.hypot(data["section_v"], data["section_w"]) * 1e3, lw=0.8, label="radial displacement")
     if np.isfinite(gap):
         ax.axhline(gap * 1e3, color="k", ls="--", lw=1, label="borehole gap")
     ax.set(xlabel="time [s]", ylabel="radial displacement [mm]", title=f"Fig. 17: radial displacement at x = {x_s:g} m")
     ax.legend(loc="lower right")
-    paths.append(_save(fig, out / "fig17_section_radial.png"))
+    paths.append(save_figure(fig, out / "fig17_section_radial.png"))
     paths.append(_time_pair(out / "fig18_impacts_time.png", t, data["impacts"], data["vertices_in_contact"],
                             ("impacts per step", "vertices in contact"), "Fig. 18: wall impacts against time"))
-    fig, (ax,) = _panels(1, 3.5)
+    fig, (ax,) = panels(1, 3.5)
     x = data["vertex_x"]
     ax.bar(x, data["impacts_per_vertex"], width=x[1] - x[0])
     ax.set(xlabel="x [m]", ylabel="impacts", title="Fig. 19: wall impacts per vertex", xlim=(x[0], x[-1]))
-    paths.append(_save(fig, out / "fig19_impacts_position.png"))
+    paths.append(save_figure(fig, out / "fig19_impacts_position.png"))
     return paths
 
 
@@ -82,7 +82,7 @@ def spectra_figures(spectra: dict, out: Path) -> list[Path]:
     paths = []
     for figure in sorted({s["figure"] for s in spectra.values()}):
         names = [n for n, s in spectra.items() if s["figure"] == figure]
-        fig, axes = _panels(len(names))
+        fig, axes = panels(len(names))
         for ax, name in zip(axes, names):
             s = spectra[name]
             ax.plot(s["frequency_hz"], s["psd_db"], color="m", lw=0.4, label="periodogram")
@@ -101,7 +101,7 @@ def spectra_figures(spectra: dict, out: Path) -> list[Path]:
             ax.legend(loc="lower left", fontsize=7)
         axes[-1].set_xlabel("frequency [Hz]")
         fig.suptitle(f"Fig. {figure}: power spectral density")
-        paths.append(_save(fig, out / f"fig{figure}_psd.png"))
+        paths.append(save_figure(fig, out / f"fig{figure}_psd.png"))
     return paths
 
 
