@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import signal
 import sys
 import time
 from pathlib import Path
@@ -66,11 +67,17 @@ def cmd_static(args) -> int:
     return 0
 
 
+def _terminate_as_interrupt(signum, frame):
+    """A batch system's SIGTERM (time limit, scancel) ends a run like Ctrl-C: summary.json is written."""
+    raise KeyboardInterrupt
+
+
 def cmd_run(args) -> int:
     """Drilling dynamics from the static equilibrium: summary.json, timeseries.h5, fields.xdmf."""
     from fenics_drill.drilling_run import run_scene
 
     scene = load_scene(args.scene, args.overrides)
+    signal.signal(signal.SIGTERM, _terminate_as_interrupt)
     summary = run_scene(scene, args.out, progress=not args.quiet)
     print(
         f"{summary['status']}: {summary['message']}; t = {summary['t_end']:.4g} s in {summary['steps']} steps, "

@@ -146,7 +146,7 @@ def run_scene(scene: dict, out: str | Path, progress: bool = True) -> dict:
         last = final if final is not None else simulation.last_state
         summary.update(_dynamics_summary(model, simulation, recorder, last, u0))
     except KeyboardInterrupt:
-        summary["status"], summary["message"] = "interrupted", "stopped by the user (Ctrl-C)"
+        summary["status"], summary["message"] = "interrupted", "stopped by Ctrl-C or SIGTERM"
         if simulation is not None and recorder is not None and simulation.last_state is not None:
             summary.update(_dynamics_summary(model, simulation, recorder, simulation.last_state, u0))
     except StaticFailure as failure:

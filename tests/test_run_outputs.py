@@ -66,3 +66,24 @@ def test_bad_scene_is_refused_before_computing(tmp_path, capsys):
     assert main(["run", "--set", "time.newmark_alpha=0.9", "--out", str(tmp_path)]) == 2
     assert "time.newmark_alpha" in capsys.readouterr().err
     assert not (tmp_path / "summary.json").exists()
+
+
+def test_sigterm_ends_a_run_like_ctrl_c_and_keeps_its_results(tmp_path):
+    """A batch system's time limit (SIGTERM) must not lose the run: summary and series are written."""
+    import subprocess
+    import sys
+    import time
+
+    long_run = ["time.t_end=1000" if a.startswith("time.t_end") else a for a in SHORT]
+    process = subprocess.Popen([sys.executable, "-m", "fenics_drill.cli", "run", *long_run, "--quiet",
+                                "--out", str(tmp_path)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    deadline = time.time() + 120
+    while not (tmp_path / "fields.h5").exists() and time.time() < deadline:
+        time.sleep(0.1)
+    time.sleep(1.0)  # some steps into the dynamics
+    process.terminate()
+    assert process.wait(timeout=60) == 130
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["status"] == "interrupted" and 0 < summary["t_end"] < 1000
+    with h5py.File(tmp_path / "timeseries.h5") as f:
+        assert f["time"][-1] == pytest.approx(summary["t_end"])
