@@ -79,6 +79,7 @@ class RunRecorder:
         self.fields = FieldWriter(model.disc, out / "fields.xdmf", with_stress=self.rows.stress is not None) \
             if self.field_interval > 0 else None
         self.next_field_time = 0.0
+        self.last_state = None  # the latest state whose row is in the series (what an interrupted run reports)
 
     def _write_fields(self, t: float, dofs: np.ndarray) -> None:
         if self.fields is not None and t >= self.next_field_time - 1e-12:
@@ -89,6 +90,7 @@ class RunRecorder:
     def __call__(self, record: StepRecord) -> None:
         dofs = self.model.space.expand(record.state.q)
         self.series.append(self.rows(record, dofs))
+        self.last_state = record.state
         self._write_fields(record.state.t, dofs)
 
     def close(self, impacts_per_vertex: np.ndarray) -> None:
@@ -147,8 +149,8 @@ def run_scene(scene: dict, out: str | Path, progress: bool = True) -> dict:
         summary.update(_dynamics_summary(model, simulation, recorder, last, u0))
     except KeyboardInterrupt:
         summary["status"], summary["message"] = "interrupted", "stopped by Ctrl-C or SIGTERM"
-        if simulation is not None and recorder is not None and simulation.last_state is not None:
-            summary.update(_dynamics_summary(model, simulation, recorder, simulation.last_state, u0))
+        if recorder is not None and recorder.last_state is not None:
+            summary.update(_dynamics_summary(model, simulation, recorder, recorder.last_state, u0))
     except StaticFailure as failure:
         summary["message"] = f"at t = 0 s: {failure}"
     finally:

@@ -79,12 +79,13 @@ class TimeSeriesWriter:
             self.flush()
 
     def flush(self, impacts_per_vertex: np.ndarray | None = None) -> None:
-        n = len(self.buffer["time"])
+        # an interrupt (Ctrl-C, SIGTERM) inside append() can leave a row half-buffered: keep whole rows only
+        n = min(len(values) for values in self.buffer.values())
         if n:
             for name, values in self.buffer.items():
                 ds = self.file[name]
                 ds.resize((ds.shape[0] + n,))
-                ds[-n:] = values
+                ds[-n:] = values[:n]
                 values.clear()
         if impacts_per_vertex is not None:
             self.file["impacts_per_vertex"][:] = impacts_per_vertex
