@@ -89,7 +89,8 @@ class DrillstringModel:
         """Residual at (q, qd, qdd, mu); with (c_u, c_v, c_a) also the tangent.
 
         ``internal_parts`` (df/dq, df/dqd, df/dqdd) of the internal force may come from an
-        earlier state (modified Newton); without them they are computed at this state.
+        earlier state (modified Newton); without them they are computed at this state, only
+        those with a non-zero coefficient.
         The force laws' tangents are always fresh.
         """
         internal = self.internal.evaluate(q, qd, qdd)
@@ -106,9 +107,10 @@ class DrillstringModel:
         out = Evaluation(residual, internal, external, wall, bit)
         if want:
             c_u, c_v, c_a = tangent_coefficients
-            parts = internal_parts if internal_parts is not None else self.internal.tangent_parts()
-            out.internal_parts = parts
-            J = c_u * parts[0] + c_v * parts[1] + c_a * parts[2]
+            needed = tuple(c != 0 for c in tangent_coefficients)
+            parts = internal_parts if internal_parts is not None else self.internal.tangent_parts(needed)
+            out.internal_parts = parts if all(p is not None for p in parts) else None  # reusable only if whole
+            J = sum(c * part for c, part in zip(tangent_coefficients, parts) if c != 0)
             if wall is not None:
                 wall_tangent = self.wall.tangent(wall, c_u, c_v)
                 if wall_tangent is not None:

@@ -40,8 +40,8 @@ class LinearInternalForce:
     #: The tangent does not depend on the state: never worth re-assembling.
     state_dependent = False
 
-    def tangent_parts(self):
-        """(df/dq, df/dqd, df/dqdd)."""
+    def tangent_parts(self, needed=(True, True, True)):
+        """(df/dq, df/dqd, df/dqdd); constant, so always all three."""
         return self.stiffness, self.damping, self.mass
 
     def kinetic_energy(self, q, qd) -> float:
@@ -107,9 +107,11 @@ class AssembledInternalForce:
         self._matrix.assemble()
         return self.space.project_matrix(petsc_to_scipy(self._matrix))
 
-    def tangent_parts(self):
-        """(df/dq, df/dqd, df/dqdd) at the state of the last :meth:`evaluate`."""
-        return self._tangent(1.0, 0.0, 0.0), self._tangent(0.0, 1.0, 0.0), self._tangent(0.0, 0.0, 1.0)
+    def tangent_parts(self, needed=(True, True, True)):
+        """(df/dq, df/dqd, df/dqdd) at the state of the last :meth:`evaluate`; None for a part not
+        ``needed`` (a static solve needs df/dq only: one assembly instead of three)."""
+        unit = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+        return tuple(self._tangent(*c) if want else None for c, want in zip(unit, needed))
 
     def kinetic_energy(self, q, qd) -> float:
         self._set(self.U, q)

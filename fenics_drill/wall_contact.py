@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from fenics_drill.discretization import BeamDiscretization
 from fenics_drill.force_laws import hunt_crossley_normal_force, indentation, regularised_sign, wall_friction
@@ -113,13 +114,28 @@ class WallContact:
 
     @staticmethod
     def tangent(forces: WallForces, c_u: float, c_v: float):
-        """c_u d f/dq + c_v d f/dqd of the generalised wall force (None without contact)."""
+        """c_u d f/dq + c_v d f/dqd of the generalised wall force (None without contact):
+        sum over (out, in) of rows_out^T diag(c_u w_pos + c_v w_vel) rows_in."""
         if not forces.derivatives:
             return None
         rows = forces.derivatives["rows"]
+        position, velocity = forces.derivatives["position"], forces.derivatives["velocity"]
+        weights: dict = {}
+        for scale, block in ((c_u, position), (c_v, velocity)):
+            for pair, w in block.items():
+                weights[pair] = weights.get(pair, 0.0) + scale * w
+        if sp.issparse(rows[U_FIELD]):
+            terms = (weighted_product(rows[out], w, rows[inp]) for (out, inp), w in weights.items())
+            return sum(terms)
+        # dense [Phi]: combine the inputs first, then one product per output field
         total = None
-        for scale, block in ((c_u, forces.derivatives["position"]), (c_v, forces.derivatives["velocity"])):
-            for (out, inp), weights in block.items():
-                term = weighted_product(rows[out], scale * weights, rows[inp])
-                total = term if total is None else total + term
+        for out in (U_FIELD, V_FIELD, W_FIELD, TX_FIELD):
+            combined = None
+            for (o, inp), w in weights.items():
+                if o == out:
+                    term = w[:, None] * rows[inp]
+                    combined = term if combined is None else combined + term
+            if combined is not None:
+                product = rows[out].T @ combined
+                total = product if total is None else total + product
         return total
