@@ -8,7 +8,7 @@ setup:
 	@bash scripts/bootstrap.sh
 
 ## The main job: the paper's nominal scene - static equilibrium, 10 s of drilling (summary.json,
-## timeseries.h5, fields.xdmf, Figs. 14-19), then the modal analysis (Figs. 10-12, Table 4).
+## timeseries.h5, fields.xdmf, Figs. 13-23, spectra.json, animation.gif), then the modal analysis (Figs. 10-12, Table 4).
 ## T_END=1 make demo runs a short version.
 T_END ?= 10.0
 demo: setup
