@@ -4,8 +4,8 @@ Every process builds the model and its static equilibrium once (neither depends 
 the bit-rock parameters), then runs its share of the realisations: realisation k on
 rank k mod P, with parameters drawn from ``default_rng([seed, k])``.  Each finished
 realisation is written at once to ``DIR/realisations/NNNNNN.h5`` (a temporary file
-renamed into place, so a killed run leaves no half-written result); ``--resume``
-skips those present.  When all are done, rank 0 reads them in index order and writes
+renamed into place, so a killed run leaves no half-written result;
+:mod:`fenics_drill.study_directory`); ``--resume`` skips those present.  When all are done, rank 0 reads them in index order and writes
 the statistics, so the result does not depend on the number of processes.
 
 A realisation file holds, on the common grid of ``uncertainty.output_interval``:
@@ -15,8 +15,6 @@ efficiency, mean bit velocity, max von Mises stress and int ||q||^2 dt (for (101
 
 from __future__ import annotations
 
-import json
-import os
 import sys
 import time
 from collections import defaultdict
@@ -31,6 +29,7 @@ from fenics_drill.drilling_run import PreparedScene, prepare
 from fenics_drill.simulation import Simulation
 from fenics_drill.step_control import StepTooSmall
 from fenics_drill.step_rows import StepRows
+from fenics_drill.study_directory import all_done, claim, write_atomic
 from fenics_drill.uncertainty import BitRockLaws
 
 #: Time histories kept per realisation (Figs. 29, 31, 33).
@@ -97,17 +96,19 @@ def run_realisation(prepared: PreparedScene, scene: dict, bit_rock: dict) -> dic
 
 def write_realisation(path: Path, result: dict) -> None:
     """Write atomically: a temporary file renamed into place."""
-    tmp = path.with_suffix(f".tmp{os.getpid()}")
-    with h5py.File(tmp, "w") as f:
-        f["time"] = result["time"]
-        f["time"].attrs["units"] = "s"
-        for name, values in result["histories"].items():
-            f[name] = values
-        for key in ("status", "message", "wall_time_s", "steps", *SCALARS):
-            f.attrs[key] = result[key]
-        for key, value in result["bit_rock"].items():
-            f.attrs[f"bit_rock.{key}"] = value
-    os.replace(tmp, path)
+
+    def write(tmp: Path) -> None:
+        with h5py.File(tmp, "w") as f:
+            f["time"] = result["time"]
+            f["time"].attrs["units"] = "s"
+            for name, values in result["histories"].items():
+                f[name] = values
+            for key in ("status", "message", "wall_time_s", "steps", *SCALARS):
+                f.attrs[key] = result[key]
+            for key, value in result["bit_rock"].items():
+                f.attrs[f"bit_rock.{key}"] = value
+
+    write_atomic(path, write)
 
 
 def read_realisation(path: Path, histories: bool = True) -> dict:
@@ -121,19 +122,6 @@ def read_realisation(path: Path, histories: bool = True) -> dict:
 
 def realisation_path(out: Path, k: int) -> Path:
     return out / "realisations" / f"{k:06d}.h5"
-
-
-def _check_resume(out: Path, scene: dict, resume: bool) -> None:
-    """Write DIR/mc.json, or check it against this study when resuming."""
-    meta_path = out / "mc.json"
-    meta = {"scene": scene}
-    done = list((out / "realisations").glob("*.h5"))
-    if meta_path.exists() and json.loads(meta_path.read_text())["scene"] != json.loads(json.dumps(scene)):
-        raise ValueError(f"{out} holds a Monte Carlo study of another scene; choose another --out")
-    if done and not resume:
-        raise ValueError(f"{out} already holds {len(done)} realisations: add --resume to continue that study, "
-                         "or choose another --out")
-    meta_path.write_text(json.dumps(meta, indent=1))
 
 
 def _progress(out: Path, samples: int, started: float, done_at_start: int) -> None:
@@ -152,16 +140,7 @@ def monte_carlo(scene: dict, samples: int, out: str | Path, resume: bool = False
     """Run (or finish) the study; rank 0 returns the summary, the other ranks None."""
     out = Path(out)
     laws = BitRockLaws(scene["bit_rock"], scene["uncertainty"])  # refuses inadmissible laws
-    error = None
-    if comm.rank == 0:
-        (out / "realisations").mkdir(parents=True, exist_ok=True)
-        try:
-            _check_resume(out, scene, resume)
-        except ValueError as err:
-            error = str(err)
-    error = comm.bcast(error, root=0)
-    if error:
-        raise ValueError(error)
+    claim(out, scene, "realisations", "*.h5", resume, comm)
     prepared = prepare(scene)
     if comm.rank == 0 and not (out / NOMINAL).exists():
         write_realisation(out / NOMINAL, run_realisation(prepared, scene, dict(scene["bit_rock"])))
@@ -174,11 +153,8 @@ def monte_carlo(scene: dict, samples: int, out: str | Path, resume: bool = False
         write_realisation(path, run_realisation(prepared, scene, laws.sample(k)))
         if progress and comm.rank == 0:
             _progress(out, samples, started, done_at_start)
-    comm.Barrier()
-    if comm.rank != 0:
+    if not all_done(comm, progress):
         return None
-    if progress:
-        sys.stderr.write("\n")
     from fenics_drill.mc_statistics import write_statistics
 
     return write_statistics(out, samples)

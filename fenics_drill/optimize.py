@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import copy
 import json
-import os
 import sys
 import time
 from pathlib import Path
@@ -32,6 +31,7 @@ from scipy import interpolate, optimize
 
 from fenics_drill.drilling_run import prepare
 from fenics_drill.monte_carlo import run_realisation
+from fenics_drill.study_directory import all_done, claim, write_atomic
 from fenics_drill.uncertainty import BitRockLaws
 
 NOMINAL_DRAW = -1
@@ -59,12 +59,6 @@ def _evaluate(prepared, scene: dict, v0: float, omega: float, bit_rock: dict) ->
     return {"status": r["status"], "message": r["message"], "rop": r["rop"], "signed_rop": r["signed_rop"],
             "efficiency": r["efficiency"], "max_von_mises": r["max_von_mises"], "bit_rock": bit_rock,
             "wall_time_s": r["wall_time_s"]}
-
-
-def _write_atomic(path: Path, data: dict) -> None:
-    tmp = path.with_suffix(f".tmp{os.getpid()}")
-    tmp.write_text(json.dumps(data, default=float))
-    os.replace(tmp, path)
 
 
 def _refine(v0: np.ndarray, omega: np.ndarray, values: np.ndarray, start: tuple[int, int]) -> dict | None:
@@ -144,33 +138,19 @@ def run_optimize(scene: dict, out: str | Path, resume: bool = False, progress: b
     v0, omega = grid_axis(opt["axial_velocity"]), grid_axis(opt["rotation_speed"])
     draws = [NOMINAL_DRAW] if opt["samples"] == 0 else list(range(opt["samples"]))
     tasks = [(i * len(omega) + j, v0[i], omega[j], d) for i in range(len(v0)) for j in range(len(omega)) for d in draws]
-    error = None
-    if comm.rank == 0:
-        (out / "points").mkdir(parents=True, exist_ok=True)
-        meta = out / "optimize_scene.json"
-        if meta.exists() and json.loads(meta.read_text()) != json.loads(json.dumps(scene)):
-            error = f"{out} holds an optimisation of another scene; choose another --out"
-        elif any((out / "points").glob("*.json")) and not resume:
-            error = f"{out} already holds results: add --resume to continue, or choose another --out"
-        else:
-            meta.write_text(json.dumps(scene, indent=1))
-    error = comm.bcast(error, root=0)
-    if error:
-        raise ValueError(error)
+    claim(out, scene, "points", "*.json", resume, comm)
     prepared = prepare(scene)
     started = time.perf_counter()
     for n, (point, a, b, draw) in enumerate(tasks):
         if n % comm.size != comm.rank or _task_path(out, point, draw).exists():
             continue
         bit_rock = dict(scene["bit_rock"]) if draw == NOMINAL_DRAW else laws.sample(draw)
-        _write_atomic(_task_path(out, point, draw), _evaluate(prepared, scene, a, b, bit_rock))
+        result = _evaluate(prepared, scene, a, b, bit_rock)
+        write_atomic(_task_path(out, point, draw), lambda tmp: tmp.write_text(json.dumps(result, default=float)))
         if progress and comm.rank == 0:
             done = len(list((out / "points").glob("*.json")))
             sys.stderr.write(f"\r  runs {done:5d} / {len(tasks)}  wall {time.perf_counter() - started:8.1f} s ")
             sys.stderr.flush()
-    comm.Barrier()
-    if comm.rank != 0:
+    if not all_done(comm, progress):
         return None
-    if progress:
-        sys.stderr.write("\n")
     return assemble(scene, out)
