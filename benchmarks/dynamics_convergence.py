@@ -18,7 +18,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from fenics_drill.drilling_run import run_scene
+from fenics_drill.studies.run import run_scene
 from fenics_drill.scene import load_scene
 
 STUDIES = {

@@ -13,8 +13,9 @@ import statistics
 import time
 from pathlib import Path
 
-from fenics_drill.modal import solve_modes
-from fenics_drill.modal_report import modal_report, scene_discretization
+from fenics_drill.model.discretization import BeamDiscretization
+from fenics_drill.model.modes import solve_modes
+from fenics_drill.studies.modal_report import modal_report
 from fenics_drill.scene import load_scene
 
 SCENE = Path(__file__).parents[1] / "demos" / "scenes" / "paper.toml"
@@ -26,9 +27,9 @@ def main(repeats: int = 5) -> None:
     totals, setups, solves = [], [], []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        disc = scene_discretization(scene)
+        disc = BeamDiscretization.from_scene(scene)
         t1 = time.perf_counter()
-        basis = solve_modes(disc, scene["modal"]["f_star_max"])
+        basis = solve_modes(disc, scene.modal.f_star_max)
         t2 = time.perf_counter()
         totals.append(t2 - t0)
         setups.append(t1 - t0)

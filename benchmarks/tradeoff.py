@@ -63,7 +63,7 @@ GROUPS = {
 WORKER = r"""
 import json, resource, sys, tempfile, time
 import h5py, numpy as np
-from fenics_drill.drilling_run import run_scene
+from fenics_drill.studies.run import run_scene
 from fenics_drill.scene import load_scene
 scene = load_scene(sys.argv[1], json.loads(sys.argv[2]))
 with tempfile.TemporaryDirectory() as tmp:
@@ -118,7 +118,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("benchmarks/tradeoff"))
     args = parser.parse_args()
     from fenics_drill.scene import load_scene
-    from fenics_drill.step_control import nominal_step
+    from fenics_drill.solvers.step_control import nominal_step
 
     nominal_dt = nominal_step(load_scene(args.scene, []))
     runs = args.out / "runs"

@@ -20,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from fenics_drill.modal_report import modal_report  # noqa: E402
+from fenics_drill.studies.modal_report import modal_report  # noqa: E402
 from fenics_drill.scene import load_scene  # noqa: E402
 
 SCENE = Path(__file__).parent / "scenes" / "paper.toml"
@@ -80,7 +80,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    diameter = 2 * load_scene(SCENE)["beam"]["outer_radius"]
+    diameter = 2 * load_scene(SCENE).beam.outer_radius
 
     reports = {}
     for length in FIGURE_LENGTHS:

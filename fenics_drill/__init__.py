@@ -1,5 +1,11 @@
 """fenics-drill: nonlinear dynamics of horizontal drillstrings on FEniCSx.
 
+The public API (see :mod:`fenics_drill.api`)::
+
+    import fenics_drill as fd
+    scene = fd.load_scene("demos/scenes/paper.toml", ["time.t_end=1"])
+    run = fd.run(scene)          # run.summary, run.series (xarray.Dataset)
+
 ``dolfinx_solver`` must be imported before ``dolfinx`` and ``petsc4py`` so that
 the real-scalar PETSc/SLEPc of the ``dolfinx-solver-real`` wheel is the one
 loaded; importing this package does that once for every module below it.
@@ -15,6 +21,21 @@ import os
 for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 
-import dolfinx_solver  # noqa: F401  (must precede dolfinx / petsc4py)
+import dolfinx_solver  # noqa: F401, E402  (must precede dolfinx / petsc4py)
+
+from fenics_drill.scene import Scene, SceneError, load_scene  # noqa: E402
 
 __version__ = "0.1.0"
+
+#: The API functions, imported on first use (``fenics-drill scene`` needs none of DOLFINx).
+_API = ("RunResult", "modal_analysis", "static_state", "run", "monte_carlo", "operating_window", "plot")
+
+__all__ = ["Scene", "SceneError", "load_scene", *_API]
+
+
+def __getattr__(name: str):
+    if name in _API:
+        from fenics_drill import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'fenics_drill' has no attribute {name!r}")

@@ -9,7 +9,7 @@ import sys
 import time
 from pathlib import Path
 
-from fenics_drill.scene import SCHEMA, SceneError, load_scene
+from fenics_drill.scene import SceneError, load_scene, section_keys
 
 
 def _scene_args(parser: argparse.ArgumentParser, out: bool = True) -> None:
@@ -25,18 +25,18 @@ def _scene_args(parser: argparse.ArgumentParser, out: bool = True) -> None:
 def cmd_scene(args) -> int:
     """Print the validated scene with every default filled in, as TOML."""
     scene = load_scene(args.scene, args.overrides)
-    for section, entries in scene.items():
+    for section, entries in scene.to_dict().items():
         print(f"[{section}]")
+        keys = section_keys(section)
         for key, value in entries.items():
-            doc = SCHEMA[section][key].doc
-            print(f"{key} = {json.dumps(value)}  # {doc}")
+            print(f"{key} = {json.dumps(value)}  # {keys[key].metadata['doc']}")
         print()
     return 0
 
 
 def cmd_modal(args) -> int:
     """Modal analysis (62) and reduced-basis selection; writes DIR/modes.json."""
-    from fenics_drill.modal_report import modal_report
+    from fenics_drill.studies.modal_report import modal_report
 
     scene = load_scene(args.scene, args.overrides)
     out = Path(args.out)
@@ -47,8 +47,8 @@ def cmd_modal(args) -> int:
     (out / "modes.json").write_text(json.dumps(report, indent=1))
     red = report["reduced_basis"]
     print(
-        f"{report['full_dofs']} dofs, {len(report['modes'])} modes with f* <= {scene['modal']['f_star_max']}, "
-        f"reduced basis ({scene['reduction']['rule']}): {red['size']} = {red['counts']} "
+        f"{report['full_dofs']} dofs, {len(report['modes'])} modes with f* <= {scene.modal.f_star_max}, "
+        f"reduced basis ({scene.reduction.rule}): {red['size']} = {red['counts']} "
         f"[{report['wall_time_s']:.1f} s] -> {out / 'modes.json'}"
     )
     return 0
@@ -56,7 +56,7 @@ def cmd_modal(args) -> int:
 
 def cmd_static(args) -> int:
     """Static equilibrium under gravity with wall contact (Section 6.4): DIR/static.json, DIR/static.xdmf."""
-    from fenics_drill.drilling_run import run_static
+    from fenics_drill.studies.run import run_static
 
     scene = load_scene(args.scene, args.overrides)
     report = run_static(scene, args.out)
@@ -74,7 +74,7 @@ def _terminate_as_interrupt(signum, frame):
 
 def cmd_run(args) -> int:
     """Drilling dynamics from the static equilibrium: summary.json, timeseries.h5, fields.xdmf."""
-    from fenics_drill.drilling_run import run_scene
+    from fenics_drill.studies.run import run_scene
 
     scene = load_scene(args.scene, args.overrides)
     signal.signal(signal.SIGTERM, _terminate_as_interrupt)
@@ -95,8 +95,8 @@ def cmd_run(args) -> int:
 
 def cmd_mc(args) -> int:
     """Monte Carlo over the random bit-rock laws; with mpiexec -n P, realisations spread over P ranks."""
-    from fenics_drill.monte_carlo import monte_carlo
-    from fenics_drill.uncertainty import InadmissibleLaw
+    from fenics_drill.studies.monte_carlo import monte_carlo
+    from fenics_drill.studies.uncertainty import InadmissibleLaw
 
     scene = load_scene(args.scene, args.overrides)
     if args.samples < 1:
@@ -118,8 +118,8 @@ def cmd_mc(args) -> int:
 
 def cmd_optimize(args) -> int:
     """The operating window: deterministic or robust optimum of rop or efficiency under the von Mises limit."""
-    from fenics_drill.optimize import run_optimize
-    from fenics_drill.uncertainty import InadmissibleLaw
+    from fenics_drill.studies.operating_window import run_optimize
+    from fenics_drill.studies.uncertainty import InadmissibleLaw
 
     scene = load_scene(args.scene, args.overrides)
     try:
@@ -139,23 +139,14 @@ def cmd_optimize(args) -> int:
 
 
 def cmd_plot(args) -> int:
-    """Figures of a saved run (Figs. 13-23) or Monte Carlo study (Figs. 28-35)."""
+    """Figures of a saved run (Figs. 13-23), Monte Carlo study (Figs. 28-35) or operating window (24-27, 36)."""
+    from fenics_drill.plots.directory import NothingToPlot, plot_directory
+
     directory = Path(args.run_dir)
-    if (directory / "optimize.json").exists():
-        from fenics_drill.optimize_plots import optimize_figures
-
-        paths = optimize_figures(directory)
-    elif (directory / "statistics.h5").exists():
-        from fenics_drill.mc_plots import mc_figures
-
-        paths = mc_figures(directory)
-    elif (directory / "timeseries.h5").exists():
-        from fenics_drill.run_figures import plot_run
-
-        paths = plot_run(directory, gif=not args.no_gif)
-    else:
-        print(f"fenics-drill: {directory} holds no timeseries.h5 ('fenics-drill run'), statistics.h5 "
-              "('fenics-drill mc') or optimize.json ('fenics-drill optimize')", file=sys.stderr)
+    try:
+        paths = plot_directory(directory, gif=not args.no_gif)
+    except NothingToPlot as err:
+        print(f"fenics-drill: {err}", file=sys.stderr)
         return 2
     print(f"{len(paths)} files in {directory}: " + ", ".join(p.name for p in paths))
     return 0
@@ -163,21 +154,20 @@ def cmd_plot(args) -> int:
 
 def cmd_forms(args) -> int:
     """List the forms, print one, or check the printed operators against the energies."""
-    from fenics_drill.discretization import BeamDiscretization
-    from fenics_drill.scene import beam_properties
+    from fenics_drill.model.discretization import BeamDiscretization
 
     scene = load_scene(args.scene, args.overrides)
     if args.action == "check":
-        from fenics_drill.form_check import compare_printed_forms
+        from fenics_drill.studies.form_check import compare_printed_forms
 
-        disc = BeamDiscretization(beam_properties(scene), 6, scene["beam"]["element_degree"], "paper")
+        disc = BeamDiscretization(scene.beam_properties, 6, scene.beam.element_degree, "paper")
         rows = compare_printed_forms(disc)
         for row in rows:
             print(f"{row.term:22s} relative L2 difference {row.relative_difference:9.2e}  {row.status}")
         return 1 if any(r.status == "UNRECORDED MISMATCH" for r in rows) else 0
-    from fenics_drill.form_catalog import form_catalog
+    from fenics_drill.studies.form_catalog import form_catalog
 
-    catalog = form_catalog(BeamDiscretization(beam_properties(scene), 2, scene["beam"]["element_degree"], "paper"))
+    catalog = form_catalog(BeamDiscretization(scene.beam_properties, 2, scene.beam.element_degree, "paper"))
     if args.action == "list":
         for name, (doc, _) in catalog.items():
             print(f"{name:16s} {doc}")

@@ -2,14 +2,19 @@
 
 import pytest
 
-from fenics_drill.scene import beam_properties, load_scene
+from pathlib import Path
+
+from fenics_drill.scene import Scene, load_scene
+
+#: The paper's nominal scene file.
+PAPER = Path(__file__).parents[1] / "demos" / "scenes" / "paper.toml"
 
 
-def scene_with(*overrides: str) -> dict:
+def scene_with(*overrides: str) -> Scene:
     """The paper scene with ``section.key=value`` overrides applied."""
     return load_scene(None, list(overrides))
 
 
 @pytest.fixture
 def paper_properties():
-    return beam_properties(scene_with())
+    return scene_with().beam_properties

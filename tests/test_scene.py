@@ -13,20 +13,20 @@ PAPER = Path(__file__).parents[1] / "demos" / "scenes" / "paper.toml"
 
 def test_paper_scene_holds_tables_1_to_3():
     s = load_scene(PAPER)
-    assert s["beam"]["length"] == 100.0 and s["beam"]["elements"] == 500
-    assert s["beam"]["young_modulus"] == 203e9 and s["beam"]["density"] == 7900.0
-    assert s["borehole"]["radius"] == 95e-3
-    assert s["contact"]["stiffness_cubic"] == 1e16 and s["bit_rock"]["rate"] == 400.0
-    assert math.isclose(s["drive"]["axial_velocity"] * 3600, 20.0)
-    assert math.isclose(s["drive"]["rotation_speed"], 2 * math.pi)
+    assert s.beam.length == 100.0 and s.beam.elements == 500
+    assert s.beam.young_modulus == 203e9 and s.beam.density == 7900.0
+    assert s.borehole.radius == 95e-3
+    assert s.contact.stiffness_cubic == 1e16 and s.bit_rock.rate == 400.0
+    assert math.isclose(s.drive.axial_velocity * 3600, 20.0)
+    assert math.isclose(s.drive.rotation_speed, 2 * math.pi)
 
 
 def test_overrides_are_toml_values():
     s = load_scene(PAPER, ["beam.length=50", "model.supports=pinned", "model.contact=false",
                            "reduction.rule='count'", "reduction.flexural=4", "reduction.torsional=2",
                            "reduction.axial=1"])
-    assert s["beam"]["length"] == 50.0 and isinstance(s["beam"]["length"], float)
-    assert s["model"]["supports"] == "pinned" and s["model"]["contact"] is False
+    assert s.beam.length == 50.0 and isinstance(s.beam.length, float)
+    assert s.model.supports == "pinned" and s.model.contact is False
     assert parse_override("optimize.rotation_speed=[4.7,7.3,5]") == ("optimize", "rotation_speed", [4.7, 7.3, 5])
 
 

@@ -1,0 +1,77 @@
+"""The public Python API (re-exported by ``fenics_drill``): what a notebook needs, one call each.
+
+    import fenics_drill as fd
+    scene = fd.load_scene("demos/scenes/paper.toml", ["time.t_end=1"])
+    modes = fd.modal_analysis(scene)            # modes.json as a dict
+    rest = fd.static_state(scene)               # static.json as a dict
+    run = fd.run(scene)                         # run.summary (dict), run.series (xarray.Dataset)
+    mc = fd.monte_carlo(scene, samples=8, out="out/mc")
+    window = fd.operating_window(scene, out="out/window")
+
+Every call takes a :class:`~fenics_drill.scene.Scene`; change one with
+``scene.with_changes(drive={"rotation_speed": 5.0})``.  The command line does the same
+through :mod:`fenics_drill.cli`.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from fenics_drill.io.timeseries import open_dataset
+from fenics_drill.plots.directory import plot_directory
+from fenics_drill.scene import Scene
+from fenics_drill.studies.modal_report import modal_report
+from fenics_drill.studies.monte_carlo import monte_carlo as _monte_carlo
+from fenics_drill.studies.operating_window import run_optimize
+from fenics_drill.studies.prepare import prepare
+from fenics_drill.studies.run import run_scene, run_static
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """A finished (or stopped) drilling run: its directory, its summary and its time series."""
+
+    directory: Path
+    summary: dict
+
+    @property
+    def series(self):
+        """The time series as an ``xarray.Dataset`` (variables carry ``units`` and ``long_name``)."""
+        return open_dataset(self.directory / "timeseries.h5")
+
+
+def modal_analysis(scene: Scene) -> dict:
+    """Modes of the band B (Eq. 62), their kinds and the reduced basis (Section 6.3): modes.json."""
+    return modal_report(scene)
+
+
+def static_state(scene: Scene, out: str | Path | None = None) -> dict:
+    """Static equilibrium under gravity with wall contact (Section 6.4): static.json; with ``out`` also
+    static.xdmf there."""
+    if out is not None:
+        return run_static(scene, out)
+    return prepare(scene).static
+
+
+def run(scene: Scene, out: str | Path | None = None, progress: bool = False) -> RunResult:
+    """Static equilibrium, then the drilling dynamics to ``time.t_end`` into ``out`` (a new temporary
+    directory if None)."""
+    directory = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="fenics-drill-run-"))
+    return RunResult(directory, run_scene(scene, directory, progress=progress))
+
+
+def monte_carlo(scene: Scene, samples: int, out: str | Path, resume: bool = False, progress: bool = False) -> dict:
+    """Monte Carlo over the random bit-rock laws (Section 6.11): the summary of ``out``/summary.json."""
+    return _monte_carlo(scene, samples, out, resume=resume, progress=progress)
+
+
+def operating_window(scene: Scene, out: str | Path, resume: bool = False, progress: bool = False) -> dict:
+    """The operating window of the scene's [optimize] section (Sections 6.9-6.12): optimize.json."""
+    return run_optimize(scene, out, resume=resume, progress=progress)
+
+
+def plot(directory: str | Path, gif: bool = False) -> list[Path]:
+    """The figures of a run, Monte Carlo study or operating window directory; returns the files."""
+    return plot_directory(Path(directory), gif=gif)

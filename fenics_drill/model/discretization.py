@@ -1,0 +1,124 @@
+"""Mesh, mixed function space and support conditions of the beam (Section 4.1).
+
+The six fields (u, v, w, theta_x, theta_y, theta_z) live in one mixed space of
+scalar Lagrange elements: v and w of degree k (the scene's
+``beam.element_degree``), u and the three rotations of degree k - 1.  The
+degree mismatch between transverse displacements and rotations avoids shear
+locking (it replaces the paper's Hermite interdependent element, which
+DOLFINx does not offer).
+"""
+
+from __future__ import annotations
+
+from functools import cached_property
+
+import basix.ufl
+import numpy as np
+from dolfinx import fem, mesh
+from mpi4py import MPI
+
+from fenics_drill.forms import FIELD_NAMES, BeamProperties
+
+#: Index of each field in the mixed space, in the paper's order (the one place they are declared).
+U, V, W, THETA_X, THETA_Y, THETA_Z = range(6)
+
+#: Fields held fixed by each support type of ``model.supports``: (field index, end).
+SUPPORTS = {
+    # Section 4.4: v, w, theta_y, theta_z fixed at x = 0; v, w fixed at x = L.
+    "paper": ((V, 0), (W, 0), (THETA_Y, 0), (THETA_Z, 0), (V, 1), (W, 1)),
+    # v, w fixed at both ends, all rotations free.
+    "pinned": ((V, 0), (W, 0), (V, 1), (W, 1)),
+}
+
+
+def field_degrees(element_degree: int) -> tuple[int, ...]:
+    """Polynomial degree of each of the six fields for a transverse degree k."""
+    k = element_degree
+    return (k - 1, k, k, k - 1, k - 1, k - 1)
+
+
+class BeamDiscretization:
+    """The interval mesh [0, L], the mixed space and the dofs of each field (serial, COMM_SELF)."""
+
+    def __init__(self, properties: BeamProperties, elements: int, element_degree: int = 2, supports: str = "paper"):
+        if supports not in SUPPORTS:
+            raise ValueError(f"unknown supports {supports!r}; expected one of {', '.join(SUPPORTS)}")
+        self.properties = properties
+        self.elements = elements
+        self.element_degree = element_degree
+        self.supports = supports
+        self.comm = MPI.COMM_SELF
+        self.mesh = mesh.create_interval(self.comm, self.elements, [0.0, self.properties.length])
+        sub = [basix.ufl.element("Lagrange", "interval", d) for d in field_degrees(self.element_degree)]
+        self.V = fem.functionspace(self.mesh, basix.ufl.mixed_element(sub))
+
+    @classmethod
+    def from_scene(cls, scene) -> "BeamDiscretization":
+        """The discretization a scene asks for (``beam.*``, ``model.supports``)."""
+        return cls(scene.beam_properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports)
+
+    @property
+    def ndofs(self) -> int:
+        return self.V.dofmap.index_map.size_global * self.V.dofmap.index_map_bs
+
+    @cached_property
+    def field_dofs(self) -> tuple[np.ndarray, ...]:
+        """For each field, the indices of its dofs in the mixed space (local numbering)."""
+        return tuple(np.asarray(self.V.sub(i).collapse()[1], dtype=np.int32).ravel() for i in range(6))
+
+    @cached_property
+    def field_of_dof(self) -> np.ndarray:
+        """Field index (0..5) of every dof of the mixed space."""
+        out = np.empty(self.ndofs, dtype=np.int8)
+        for i, dofs in enumerate(self.field_dofs):
+            out[dofs] = i
+        return out
+
+    def end_dof(self, field: int, end: int) -> int:
+        """Index of the dof of ``field`` sitting at x = 0 (end=0) or x = L (end=1)."""
+        x_end = 0.0 if end == 0 else self.properties.length
+        vertices = mesh.locate_entities_boundary(self.mesh, 0, lambda x: np.isclose(x[0], x_end))
+        dofs = fem.locate_dofs_topological(self.V.sub(field), 0, vertices)
+        if len(dofs) != 1:
+            raise RuntimeError(f"expected one dof of {FIELD_NAMES[field]} at x = {x_end}, got {len(dofs)}")
+        return int(dofs[0])
+
+    @cached_property
+    def support_dofs(self) -> np.ndarray:
+        """Dofs held at zero by the supports (the Dirichlet rows of the modal problem)."""
+        return np.array(sorted(self.end_dof(f, e) for f, e in SUPPORTS[self.supports]), dtype=np.int32)
+
+    def support_bcs(self) -> list[fem.DirichletBC]:
+        """Homogeneous Dirichlet conditions for the supports, one per constrained field/end."""
+        bcs = []
+        for field, end in SUPPORTS[self.supports]:
+            dof = np.array([self.end_dof(field, end)], dtype=np.int32)
+            bcs.append(fem.dirichletbc(np.float64(0.0), dof, self.V.sub(field)))
+        return bcs
+
+    @cached_property
+    def dof_coordinates(self) -> np.ndarray:
+        """x coordinate of every dof of the mixed space."""
+        x = np.empty(self.ndofs)
+        for i, dofs in enumerate(self.field_dofs):
+            Vi, _ = self.V.sub(i).collapse()
+            x[dofs] = Vi.tabulate_dof_coordinates()[:, 0]
+        return x
+
+    @cached_property
+    def vertex_x(self) -> np.ndarray:
+        """x of the mesh vertices, increasing (the nodes where wall impacts act, Section 2.3)."""
+        return np.sort(self.mesh.geometry.x[:, 0])
+
+    def vertex_dofs(self, field: int) -> np.ndarray:
+        """Dofs of ``field`` at the mesh vertices, in the order of :attr:`vertex_x`."""
+        dofs = self.field_dofs[field]
+        x = self.dof_coordinates[dofs]
+        order = np.argsort(x)
+        xs = x[order]
+        right = np.clip(np.searchsorted(xs, self.vertex_x), 1, len(xs) - 1)
+        nearest = np.where(np.abs(xs[right - 1] - self.vertex_x) <= np.abs(xs[right] - self.vertex_x), right - 1, right)
+        found = dofs[order][nearest]
+        if not np.allclose(self.dof_coordinates[found], self.vertex_x, atol=1e-9 * self.properties.length):
+            raise RuntimeError(f"field {FIELD_NAMES[field]} has no dof at every vertex")
+        return found

@@ -1,0 +1,143 @@
+"""The discrete drillstring of a scene: Eq. (65) plus the constraints (72), ready for Newton.
+
+    r(q, qd, qdd, mu) = f_int(q, qd, qdd) - sum_k f_k(q, qd) + [B]^T mu = 0
+    [B] q = h(t) = h0 + (V0, Omega) t
+
+f_int is the projected left-hand side of (43); the f_k are the point forces the
+scene's ``model`` switches turn on (:mod:`fenics_drill.model.forces`: gravity (52),
+wall impacts (50), bit-rock (51)).  The multipliers mu are the lambda of the
+Lagrangian (74): -lambda_1 and -lambda_4 are the force and torque the drive applies
+at x = 0 (the rows of [B] the supports leave to enforce).
+
+A model is not changed behind its users' backs: :meth:`DrillstringModel.with_drive`,
+:meth:`~DrillstringModel.with_bit_rock` and :meth:`~DrillstringModel.with_force` return
+new models that share the expensive parts (space, operators, internal force).
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fenics_drill.model.discretization import THETA_X, U, V, W, BeamDiscretization
+from fenics_drill.model.forces import ForceEvaluation, build_forces
+from fenics_drill.model.internal_force import internal_force
+from fenics_drill.model.operators import LinearOperators, assemble_linear
+from fenics_drill.model.spaces import solution_space
+
+
+@dataclass
+class Evaluation:
+    """Residual of (65)+(72) at one state, its pieces and (optionally) its tangent."""
+
+    residual: np.ndarray
+    internal: np.ndarray
+    external: np.ndarray
+    forces: dict[str, ForceEvaluation] = field(default_factory=dict)  # by force name
+    tangent: object = None
+    internal_parts: tuple | None = None
+
+
+class DrillstringModel:
+    """Operators, point forces and constraints of one scene in one solution space."""
+
+    def __init__(self, scene, disc: BeamDiscretization, space, operators: LinearOperators, basis=None,
+                 modes=None):
+        self.scene, self.disc, self.space, self.basis = scene, disc, space, basis
+        self.modes = modes  # every mode of the band B, kept or not (to name spectral peaks)
+        self.gap = scene.borehole.radius - disc.properties.outer_radius
+        self.mass = space.project_matrix(operators.mass)
+        self.internal = internal_force(disc, space, operators, scene.model)
+        self.forces = build_forces(scene, disc, space, operators)
+        drive_dofs = [disc.end_dof(U, 0), disc.end_dof(THETA_X, 0)]
+        rows = space.rows(drive_dofs)
+        self.constraints = rows.toarray() if space.sparse else rows  # [B], 2 x N_red (72)
+        self.drive_rate = np.array([scene.drive.axial_velocity, scene.drive.rotation_speed])
+        self.lateral_rows = (space.rows(disc.vertex_dofs(V)), space.rows(disc.vertex_dofs(W)))
+        self.bit_rows = space.rows([disc.end_dof(U, 1), disc.end_dof(THETA_X, 1)])
+        self._operators = operators
+
+    @property
+    def size(self) -> int:
+        return self.space.size
+
+    def force(self, name: str):
+        """The point force called ``name`` (``gravity``, ``wall``, ``bit_rock``), or None if off."""
+        return next((f for f in self.forces if f.name == name), None)
+
+    def with_force(self, replacement) -> "DrillstringModel":
+        """A model whose force of the same name is ``replacement`` (everything else shared)."""
+        model = copy.copy(self)
+        model.forces = [replacement if f.name == replacement.name else f for f in self.forces]
+        return model
+
+    def with_bit_rock(self, bit_rock) -> "DrillstringModel":
+        """A model with other bit-rock parameters (a Monte Carlo realisation); nothing else depends on them."""
+        bit = self.force("bit_rock")
+        return self if bit is None else self.with_force(bit.with_parameters(bit_rock))
+
+    def with_drive(self, axial_velocity: float, rotation_speed: float) -> "DrillstringModel":
+        """A model with other drive speeds V0, Omega (a point of an operating window)."""
+        model = copy.copy(self)
+        model.drive_rate = np.array([axial_velocity, rotation_speed])
+        return model
+
+    def drive_velocity_field(self) -> np.ndarray:
+        """Initial velocity of Section 3.2 in reduced coordinates: u_dot = V0, theta_x_dot = Omega,
+        projected with the mass as in (54) (exact: both are rigid-body motions)."""
+        full = np.zeros(self.disc.ndofs)
+        full[self.disc.field_dofs[U]] = self.drive_rate[0]
+        full[self.disc.field_dofs[THETA_X]] = self.drive_rate[1]
+        return self.space.solve(self.mass, self.space.project(self._operators.mass @ full))
+
+    def evaluate(self, q, qd, qdd, mu, tangent_coefficients=None, internal_parts=None) -> Evaluation:
+        """Residual at (q, qd, qdd, mu); with (c_u, c_v, c_a) also the tangent.
+
+        ``internal_parts`` (df/dq, df/dqd, df/dqdd) of the internal force may come from an
+        earlier state (modified Newton); without them they are computed at this state, only
+        those with a non-zero coefficient.
+        The point forces' tangents are always fresh.
+        """
+        internal = self.internal.evaluate(q, qd, qdd)
+        external = np.zeros_like(q)
+        want = tangent_coefficients is not None
+        evaluations = {}
+        for force in self.forces:
+            evaluations[force.name] = force.evaluate(q, qd, with_tangent=want)
+            external += evaluations[force.name].generalised
+        residual = internal - external + self.constraints.T @ mu
+        out = Evaluation(residual, internal, external, evaluations)
+        if want:
+            c_u, c_v, c_a = tangent_coefficients
+            needed = tuple(c != 0 for c in tangent_coefficients)
+            parts = internal_parts if internal_parts is not None else self.internal.tangent_parts(needed)
+            out.internal_parts = parts if all(p is not None for p in parts) else None  # reusable only if whole
+            J = sum(c * part for c, part in zip(tangent_coefficients, parts) if c != 0)
+            for force in self.forces:
+                force_tangent = force.tangent(evaluations[force.name], c_u, c_v)
+                if force_tangent is not None:
+                    J = J - force_tangent
+            out.tangent = J
+        return out
+
+    def potential_energy(self, evaluation: Evaluation) -> float:
+        """Energy stored by the point forces at an evaluated state (gravity, wall springs)."""
+        potential = 0.0
+        for force in self.forces:
+            potential += evaluation.forces[force.name].potential
+        return potential
+
+    def bit_state(self, q, qd) -> tuple[float, float, float, float]:
+        """u(L), u_dot(L), theta_x(L), theta_x_dot(L)."""
+        (u, tx), (du, dtx) = self.bit_rows @ q, self.bit_rows @ qd
+        return float(u), float(du), float(tx), float(dtx)
+
+
+def build_model(scene) -> DrillstringModel:
+    """Discretize, solve the modal problem, choose the basis and build the model of a scene."""
+    disc = BeamDiscretization.from_scene(scene)
+    operators = assemble_linear(disc)
+    space, basis, modes = solution_space(scene, disc, operators)
+    return DrillstringModel(scene, disc, space, operators, basis, modes)

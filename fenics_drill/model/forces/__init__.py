@@ -1,0 +1,29 @@
+"""Forces applied at points or vertices of the string, one module per force, each law beside its
+derivative; all implement :class:`~fenics_drill.model.forces.protocol.PointForce`.
+
+:data:`FORCES` is the registry: the model builds, in this order, every force whose
+[model] switch (its ``switch`` attribute) the scene turns on.  Adding a force law is one module here, one
+entry in :data:`FORCES` and one scene section (docs/architecture.md).
+"""
+
+from fenics_drill.model.forces.bit_rock import BitRock
+from fenics_drill.model.forces.gravity import Gravity
+from fenics_drill.model.forces.protocol import ForceEvaluation, PointForce
+from fenics_drill.model.forces.wall_contact import WallContact
+
+#: Every force the model knows, in the order their generalised forces are summed.
+FORCES = (Gravity, WallContact, BitRock)
+
+
+def build_forces(scene, disc, space, operators) -> list:
+    """The forces a scene switches on, built in the solution space."""
+    return [force.from_scene(scene, disc, space, operators) for force in FORCES if getattr(scene.model, force.switch)]
+
+
+def recorded_variables() -> dict[str, tuple[str, str]]:
+    """name -> (units, long name) of every per-step quantity some force records."""
+    return {name: meta for force in FORCES for name, meta in force.recorded.items()}
+
+
+__all__ = ["FORCES", "BitRock", "ForceEvaluation", "Gravity", "PointForce", "WallContact", "build_forces",
+           "recorded_variables"]

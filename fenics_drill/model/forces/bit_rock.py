@@ -1,0 +1,108 @@
+"""Bit-rock force and torque at x = L, Eqs. (20)-(22), (41), (51), with their tangents.
+
+The pointwise laws come first, in their physically consistent form (docs/errata.md):
+the force and the torque never do positive work on the string.  :class:`BitRock`
+projects them on the solution space and differentiates them for the Newton tangent.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
+from fenics_drill.model.forces.protocol import ForceEvaluation
+from fenics_drill.model.spaces import weighted_product
+
+
+def bit_rock_force(bit_velocity, limit_force, rate):
+    """F_BR = Gamma_BR (exp(-alpha_BR u_dot_bit) - 1) for u_dot_bit > 0, else 0, Eq. (20)."""
+    u = np.asarray(bit_velocity, dtype=float)
+    return np.where(u > 0, limit_force * np.expm1(-rate * np.maximum(u, 0.0)), 0.0)
+
+
+def torque_regularisation(omega):
+    """xi_BR(omega) = tanh(omega) + 2 omega / (1 + omega^2), Eq. (22); odd, sign of omega."""
+    omega = np.asarray(omega, dtype=float)
+    return np.tanh(omega) + 2.0 * omega / (1.0 + omega**2)
+
+
+def bit_rock_torque(bit_force, bit_spin_rate, friction, borehole_radius):
+    """T_BR = -mu_BR |F_BR| R_bh xi_BR(omega_bit), Eq. (21) with the magnitude of F_BR."""
+    return -friction * np.abs(bit_force) * borehole_radius * torque_regularisation(bit_spin_rate)
+
+
+def torque_regularisation_slope(omega):
+    """d xi_BR / d omega of Eq. (22)."""
+    omega = np.asarray(omega, dtype=float)
+    return 1.0 / np.cosh(omega) ** 2 + 2.0 * (1.0 - omega**2) / (1.0 + omega**2) ** 2
+
+
+@dataclass
+class BitForces(ForceEvaluation):
+    """The bit's state and reaction; ``generalised`` is [Phi]^T of (51), all of it dissipative."""
+
+    bit_velocity: float = 0.0
+    bit_spin_rate: float = 0.0
+    force: float = 0.0  # F_BR [N]
+    torque: float = 0.0  # T_BR [N m]
+    d_force: float = 0.0  # dF_BR / d u_dot_bit
+    d_torque_velocity: float = 0.0  # dT_BR / d u_dot_bit
+    d_torque_spin: float = 0.0  # dT_BR / d omega_bit
+
+
+class BitRock:
+    """Reaction of the rock on the bit (x = L): F_BR on u, T_BR on theta_x."""
+
+    name: ClassVar[str] = "bit_rock"
+    switch: ClassVar[str] = "bit_rock"
+    conservative: ClassVar[bool] = False
+    recorded: ClassVar[dict] = {
+        "bit_force": ("N", "bit-rock force F_BR, Eq. (20)"),
+        "bit_torque": ("N m", "bit-rock torque T_BR, Eq. (21)"),
+    }
+
+    def __init__(self, disc: BeamDiscretization, space, bit_rock, borehole_radius: float):
+        """``bit_rock``: the scene's [bit_rock] section (or a realisation of it)."""
+        self.row_u = space.rows([disc.end_dof(U, 1)])  # 1 x N_red: q -> u(L)
+        self.row_tx = space.rows([disc.end_dof(THETA_X, 1)])  # 1 x N_red: q -> theta_x(L)
+        self.limit_force, self.rate = bit_rock.limit_force, bit_rock.rate
+        self.friction, self.borehole_radius = bit_rock.friction, borehole_radius
+
+    @classmethod
+    def from_scene(cls, scene, disc, space, operators) -> "BitRock":
+        return cls(disc, space, scene.bit_rock, scene.borehole.radius)
+
+    def with_parameters(self, bit_rock) -> "BitRock":
+        """A copy with other law parameters (a Monte Carlo realisation of [bit_rock])."""
+        changed = copy.copy(self)
+        changed.limit_force, changed.rate, changed.friction = bit_rock.limit_force, bit_rock.rate, bit_rock.friction
+        return changed
+
+    def record(self, forces: "BitForces") -> dict[str, float]:
+        return {"bit_force": forces.force, "bit_torque": forces.torque}
+
+    def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> BitForces:
+        u_dot, omega = float((self.row_u @ qd)[0]), float((self.row_tx @ qd)[0])
+        force = float(bit_rock_force(u_dot, self.limit_force, self.rate))
+        torque = float(bit_rock_torque(force, omega, self.friction, self.borehole_radius))
+        d_force = -self.limit_force * self.rate * np.exp(-self.rate * u_dot) if u_dot > 0 else 0.0
+        xi = float(torque_regularisation(omega))
+        # T = -mu |F| R xi = mu F R xi  (F <= 0)
+        d_torque_velocity = self.friction * self.borehole_radius * xi * d_force
+        d_torque_spin = self.friction * force * self.borehole_radius * float(torque_regularisation_slope(omega))
+        generalised = self.row_u.T @ np.array([force]) + self.row_tx.T @ np.array([torque])
+        return BitForces(generalised, generalised, 0.0, u_dot, omega, force, torque, d_force, d_torque_velocity,
+                         d_torque_spin)
+
+    def tangent(self, forces: BitForces, c_u: float, c_v: float):
+        """c_v d f_BR / d qd (the law depends on velocities only, so c_u plays no part)."""
+        gu, gt = self.row_u, self.row_tx
+        return (
+            weighted_product(gu, np.array([c_v * forces.d_force]), gu)
+            + weighted_product(gt, np.array([c_v * forces.d_torque_velocity]), gu)
+            + weighted_product(gt, np.array([c_v * forces.d_torque_spin]), gt)
+        )

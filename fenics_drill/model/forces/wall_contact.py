@@ -1,0 +1,201 @@
+"""Wall impacts at the mesh vertices, Eqs. (16)-(19), (40), (50), with their tangents.
+
+Every vertex carries the Hunt-Crossley normal force (17) (damper c |delta|^3 delta_dot),
+the axial friction force (18) and the friction torque (19) in their physically
+consistent form (docs/errata.md): the normal force never pulls the string towards the
+wall, and friction never does positive work.  The pointwise laws come first, then
+:class:`WallContact` projects them on the solution space and differentiates them
+for the Newton tangent.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+import scipy.sparse as sp
+
+from fenics_drill.model.discretization import THETA_X as TX_FIELD
+from fenics_drill.model.discretization import U as U_FIELD
+from fenics_drill.model.discretization import V as V_FIELD
+from fenics_drill.model.discretization import W as W_FIELD
+from fenics_drill.model.discretization import BeamDiscretization
+from fenics_drill.model.forces.protocol import ForceEvaluation
+from fenics_drill.model.spaces import weighted_product
+
+
+def indentation(v, w, gap):
+    """delta_FS = r - gap, r = sqrt(v^2 + w^2), Eq. (16); positive in contact."""
+    return np.hypot(v, w) - gap
+
+
+def hunt_crossley_normal_force(delta, delta_rate, stiffness_linear, stiffness_cubic, damping):
+    """Radial force on the string (<= 0: towards the axis), Eq. (17) with the damper c |delta|^3 delta_dot.
+
+    Zero out of contact, and clipped at zero so the damper never makes the wall pull.
+    """
+    delta = np.asarray(delta, dtype=float)
+    in_contact = delta > 0
+    d = np.where(in_contact, delta, 0.0)
+    force = -stiffness_linear * d - stiffness_cubic * d**3 - damping * np.abs(d) ** 3 * delta_rate
+    return np.where(in_contact, np.minimum(force, 0.0), 0.0)
+
+
+def regularised_sign(x, velocity_scale):
+    """tanh(x / velocity_scale): Coulomb's sgn, smoothed so Newton can converge."""
+    return np.tanh(np.asarray(x, dtype=float) / velocity_scale)
+
+
+def wall_friction(normal_force, axial_velocity, spin_rate, friction, borehole_radius, velocity_scale):
+    """Axial friction force (18) and friction torque (19) with the magnitude |F_n|:
+    F_a = -mu |F_n| sgn(u_dot), T = -mu |F_n| R_bh sgn(theta_x_dot).
+
+    Both signs are regularised on a sliding speed: u_dot and R_bh theta_x_dot."""
+    magnitude = friction * np.abs(normal_force)
+    force = -magnitude * regularised_sign(axial_velocity, velocity_scale)
+    torque = -magnitude * borehole_radius * regularised_sign(borehole_radius * np.asarray(spin_rate), velocity_scale)
+    return force, torque
+
+
+@dataclass
+class WallForces(ForceEvaluation):
+    """Nodal state and forces of one evaluation (arrays over the vertices).
+
+    ``generalised`` is [Phi]^T of (50); ``dissipative`` the same without the elastic springs
+    -k1 delta - k2 delta^3; ``potential`` the sum of k1 delta^2 / 2 + k2 delta^4 / 4 over the
+    vertices in contact."""
+
+    indentation: np.ndarray = None
+    in_contact: np.ndarray = None
+    normal: np.ndarray = None  # F_n (<= 0)
+    axial: np.ndarray = None  # F_a
+    torque: np.ndarray = None  # T_FS
+    derivatives: dict | None = None
+
+
+class WallContact:
+    """Impact and friction forces of the borehole wall on the vertices of the mesh."""
+
+    name: ClassVar[str] = "wall"
+    switch: ClassVar[str] = "contact"
+    conservative: ClassVar[bool] = False
+    recorded: ClassVar[dict] = {
+        "vertices_in_contact": ("1", "vertices in contact with the wall at the end of the step"),
+    }
+
+    def __init__(self, disc: BeamDiscretization, space, contact, borehole_radius: float):
+        """``contact``: the scene's [contact] section."""
+        self.x = disc.vertex_x
+        self.gap = borehole_radius - disc.properties.outer_radius
+        self.borehole_radius = borehole_radius
+        self.k1, self.k2 = contact.stiffness_linear, contact.stiffness_cubic
+        self.c, self.mu = contact.damping, contact.friction
+        self.v_s = contact.sliding_velocity_scale
+        self.rows = {f: space.rows(disc.vertex_dofs(f)) for f in (U_FIELD, V_FIELD, W_FIELD, TX_FIELD)}
+
+    @classmethod
+    def from_scene(cls, scene, disc, space, operators) -> "WallContact":
+        return cls(disc, space, scene.contact, scene.borehole.radius)
+
+    def with_stiffness_scale(self, factor: float) -> "WallContact":
+        """A copy whose wall springs k_FS1, k_FS2 are scaled by ``factor`` (the static continuation)."""
+        scaled = copy.copy(self)
+        scaled.k1, scaled.k2 = factor * self.k1, factor * self.k2
+        return scaled
+
+    def record(self, forces: "WallForces") -> dict[str, float]:
+        return {"vertices_in_contact": int(forces.in_contact.sum())}
+
+    def lateral(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """v and w at every vertex."""
+        return self.rows[V_FIELD] @ q, self.rows[W_FIELD] @ q
+
+    def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> WallForces:
+        v, w = self.lateral(q)
+        delta = indentation(v, w, self.gap)
+        active = np.flatnonzero(delta > 0)
+        r = self.rows
+        zero = np.zeros_like(q)
+        if active.size == 0:
+            empty = np.zeros(0)
+            return WallForces(zero, zero, 0.0, delta, delta > 0, empty, empty, empty, {} if with_tangent else None)
+        rows = {f: r[f][active] for f in r}
+        va, wa = v[active], w[active]
+        dv, dw = rows[V_FIELD] @ qd, rows[W_FIELD] @ qd
+        du, dtx = rows[U_FIELD] @ qd, rows[TX_FIELD] @ qd
+        radius = np.hypot(va, wa)
+        n_v, n_w = va / radius, wa / radius
+        d = delta[active]
+        d_rate = n_v * dv + n_w * dw
+        normal = hunt_crossley_normal_force(d, d_rate, self.k1, self.k2, self.c)
+        axial, torque = wall_friction(normal, du, dtx, self.mu, self.borehole_radius, self.v_s)
+        elastic = -self.k1 * d - self.k2 * d**3
+        generalised = (
+            rows[U_FIELD].T @ axial + rows[V_FIELD].T @ (normal * n_v)
+            + rows[W_FIELD].T @ (normal * n_w) + rows[TX_FIELD].T @ torque
+        )
+        dissipative = generalised - rows[V_FIELD].T @ (elastic * n_v) - rows[W_FIELD].T @ (elastic * n_w)
+        potential = float(np.sum(0.5 * self.k1 * d**2 + 0.25 * self.k2 * d**4))
+        out = WallForces(generalised, dissipative, potential, delta, delta > 0, normal, axial, torque)
+        if with_tangent:
+            out.derivatives = self._derivatives(rows, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal)
+        return out
+
+    def _derivatives(self, rows, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal) -> dict:
+        """Pointwise derivatives of (F_a, F_v, F_w, T) w.r.t. vertex displacements and velocities."""
+        pushing = normal < 0  # where the clip of (17) is active the force and its derivatives vanish
+        spring = np.where(pushing, -self.k1 - 3 * self.k2 * d**2 - 3 * self.c * d**2 * d_rate, 0.0)
+        damper = np.where(pushing, -self.c * d**3, 0.0)
+        # d delta / d(v, w) = n ; d delta_rate / d(v, w) = (v_dot - delta_rate n) / r
+        dFn_dv = spring * n_v + damper * (dv - d_rate * n_v) / radius
+        dFn_dw = spring * n_w + damper * (dw - d_rate * n_w) / radius
+        dFn_ddv, dFn_ddw = damper * n_v, damper * n_w
+        R, mu = self.borehole_radius, self.mu
+        s_a = regularised_sign(du, self.v_s)
+        s_t = regularised_sign(R * dtx, self.v_s)
+        # F_a = mu F_n s_a and T = mu R F_n s_t since |F_n| = -F_n
+        fa, ft = mu * s_a, mu * R * s_t
+        curv = normal / radius
+        U, V, W, TX = U_FIELD, V_FIELD, W_FIELD, TX_FIELD
+        position = {  # (output field, input field): d F_out / d y_in
+            (V, V): dFn_dv * n_v + curv * n_w**2, (V, W): dFn_dw * n_v - curv * n_v * n_w,
+            (W, V): dFn_dv * n_w - curv * n_v * n_w, (W, W): dFn_dw * n_w + curv * n_v**2,
+            (U, V): fa * dFn_dv, (U, W): fa * dFn_dw, (TX, V): ft * dFn_dv, (TX, W): ft * dFn_dw,
+        }
+        velocity = {
+            (V, V): dFn_ddv * n_v, (V, W): dFn_ddw * n_v, (W, V): dFn_ddv * n_w, (W, W): dFn_ddw * n_w,
+            (U, V): fa * dFn_ddv, (U, W): fa * dFn_ddw, (TX, V): ft * dFn_ddv, (TX, W): ft * dFn_ddw,
+            (U, U): mu * normal * (1 - s_a**2) / self.v_s,
+            (TX, TX): mu * R * normal * (1 - s_t**2) * R / self.v_s,
+        }
+        return {"rows": rows, "position": position, "velocity": velocity}
+
+    @staticmethod
+    def tangent(forces: WallForces, c_u: float, c_v: float):
+        """c_u d f/dq + c_v d f/dqd of the generalised wall force (None without contact):
+        sum over (out, in) of rows_out^T diag(c_u w_pos + c_v w_vel) rows_in."""
+        if not forces.derivatives:
+            return None
+        rows = forces.derivatives["rows"]
+        position, velocity = forces.derivatives["position"], forces.derivatives["velocity"]
+        weights: dict = {}
+        for scale, block in ((c_u, position), (c_v, velocity)):
+            for pair, w in block.items():
+                weights[pair] = weights.get(pair, 0.0) + scale * w
+        if sp.issparse(rows[U_FIELD]):
+            terms = (weighted_product(rows[out], w, rows[inp]) for (out, inp), w in weights.items())
+            return sum(terms)
+        # dense [Phi]: combine the inputs first, then one product per output field
+        total = None
+        for out in (U_FIELD, V_FIELD, W_FIELD, TX_FIELD):
+            combined = None
+            for (o, inp), w in weights.items():
+                if o == out:
+                    term = w[:, None] * rows[inp]
+                    combined = term if combined is None else combined + term
+            if combined is not None:
+                product = rows[out].T @ combined
+                total = product if total is None else total + product
+        return total

@@ -1,0 +1,134 @@
+"""Internal generalised forces of the beam in the solution space, with their tangents.
+
+f_int(q, qd, qdd) = [Phi]^T (inertial + damping + elastic)(Phi q, Phi qd, Phi qdd), i.e. the
+left-hand side M a + C v + K u - F_KE - F_SE of Eqs. (43)-(49), projected as in (65).
+
+* :class:`LinearInternalForce` - both nonlinearities off: the projected constant
+  matrices M, C, K and nothing is assembled while stepping.
+* :class:`AssembledInternalForce` - the energy-derived UFL forms of
+  ``forms.energies`` assembled at the current state, tangent from ``ufl.derivative``.
+
+Both give the three parts of the tangent  c_u df/dq + c_v df/dqd + c_a df/dqdd  that
+Newton combines (for Newmark: c_u = 1, c_v = gamma / (beta dt), c_a = 1 / (beta dt^2)),
+so a change of step size needs no re-assembly.
+"""
+
+from __future__ import annotations
+
+import dolfinx.fem.petsc as fem_petsc
+import numpy as np
+import ufl
+from dolfinx import fem
+from petsc4py import PETSc
+
+from fenics_drill.forms import energies
+from fenics_drill.model.discretization import BeamDiscretization
+from fenics_drill.model.operators import LinearOperators, petsc_to_scipy
+
+
+class LinearInternalForce:
+    """M qdd + C qd + K q with projected constant matrices (Eqs. 44-46)."""
+
+    def __init__(self, space, operators: LinearOperators):
+        self.mass = space.project_matrix(operators.mass)
+        self.damping = space.project_matrix(operators.damping)
+        self.stiffness = space.project_matrix(operators.stiffness)
+
+    def evaluate(self, q, qd, qdd) -> np.ndarray:
+        return self.mass @ qdd + self.damping @ qd + self.stiffness @ q
+
+    #: The tangent does not depend on the state: never worth re-assembling.
+    state_dependent = False
+
+    def tangent_parts(self, needed=(True, True, True)):
+        """(df/dq, df/dqd, df/dqdd); constant, so always all three."""
+        return self.stiffness, self.damping, self.mass
+
+    def kinetic_energy(self, q, qd) -> float:
+        return 0.5 * float(qd @ (self.mass @ qd))
+
+    def strain_energy(self, q) -> float:
+        return 0.5 * float(q @ (self.stiffness @ q))
+
+    def damping_force(self, qd) -> np.ndarray:
+        return self.damping @ qd
+
+
+class AssembledInternalForce:
+    """Inertial (24), damping (38) and elastic (30) forces assembled from their energies."""
+
+    def __init__(self, disc: BeamDiscretization, space, operators: LinearOperators,
+                 geometric_nonlinearity: bool, inertial_nonlinearity: bool, kinematics: str = "objective"):
+        self.space = space
+        p = disc.properties
+        # Energies are polynomials of degree <= 4 in the fields up to sin/cos(theta_x):
+        # 2k integrates the mass exactly for v, w of degree k and keeps the kernels small.
+        dx = ufl.Measure("dx", domain=disc.mesh, metadata={"quadrature_degree": 2 * disc.element_degree})
+        self.U, self.V, self.A = (fem.Function(disc.V) for _ in range(3))
+        psi, dU = ufl.TestFunction(disc.V), ufl.TrialFunction(disc.V)
+        residual = (
+            energies.inertial_force(p, psi, self.U, self.V, self.A, dx, inertial_nonlinearity)
+            + energies.damping_force(p, psi, self.V, dx)
+            + energies.elastic_force(p, psi, self.U, dx, geometric_nonlinearity, kinematics)
+        )
+        self.c_u, self.c_v, self.c_a = (fem.Constant(disc.mesh, PETSc.ScalarType(0.0)) for _ in range(3))
+        jacobian = (
+            self.c_u * ufl.derivative(residual, self.U, dU)
+            + self.c_v * ufl.derivative(residual, self.V, dU)
+            + self.c_a * ufl.derivative(residual, self.A, dU)
+        )
+        self._residual = fem.form(residual)
+        self._jacobian = fem.form(jacobian)
+        self._kinetic = fem.form(energies.kinetic_energy_density(p, self.U, self.V, inertial_nonlinearity) * dx)
+        strain = energies.strain_energy_density(p, energies.strain_slots(self.U), geometric_nonlinearity, kinematics)
+        self._strain = fem.form(strain * dx)
+        self._vector = fem_petsc.create_vector(self._residual.function_spaces)
+        self._matrix = fem_petsc.create_matrix(self._jacobian)
+        self._damping = space.project_matrix(operators.damping)  # (45) is linear: reused for the budget
+
+    def _set(self, function: fem.Function, values: np.ndarray) -> None:
+        function.x.array[:] = self.space.expand(values)
+
+    def evaluate(self, q, qd, qdd) -> np.ndarray:
+        self._set(self.U, q)
+        self._set(self.V, qd)
+        self._set(self.A, qdd)
+        with self._vector.localForm() as local:
+            local.set(0.0)
+        fem_petsc.assemble_vector(self._vector, self._residual)
+        return self.space.project(self._vector.array)
+
+    state_dependent = True
+
+    def _tangent(self, c_u: float, c_v: float, c_a: float):
+        self.c_u.value, self.c_v.value, self.c_a.value = c_u, c_v, c_a
+        self._matrix.zeroEntries()
+        fem_petsc.assemble_matrix(self._matrix, self._jacobian)
+        self._matrix.assemble()
+        return self.space.project_matrix(petsc_to_scipy(self._matrix))
+
+    def tangent_parts(self, needed=(True, True, True)):
+        """(df/dq, df/dqd, df/dqdd) at the state of the last :meth:`evaluate`; None for a part not
+        ``needed`` (a static solve needs df/dq only: one assembly instead of three)."""
+        unit = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+        return tuple(self._tangent(*c) if want else None for c, want in zip(unit, needed))
+
+    def kinetic_energy(self, q, qd) -> float:
+        self._set(self.U, q)
+        self._set(self.V, qd)
+        return fem.assemble_scalar(self._kinetic)
+
+    def strain_energy(self, q) -> float:
+        self._set(self.U, q)
+        return fem.assemble_scalar(self._strain)
+
+    def damping_force(self, qd) -> np.ndarray:
+        return self._damping @ qd
+
+
+def internal_force(disc: BeamDiscretization, space, operators: LinearOperators, model):
+    """The internal force the scene's [model] switches ask for: nothing nonlinear is assembled when off."""
+    geometric, inertial = model.geometric_nonlinearity, model.inertial_nonlinearity
+    if not (geometric or inertial):
+        return LinearInternalForce(space, operators)
+    return AssembledInternalForce(disc, space, operators, geometric, inertial, model.kinematics)

@@ -1,0 +1,145 @@
+"""The space the dynamics is solved in: Q = [Phi] q, Eqs. (63)-(64).
+
+Two kinds share one interface so the integrator never asks which it has:
+
+* :class:`ModalSpace` - the columns of [Phi] are M-orthonormal modes (dense,
+  N_dofs x N_red); projected operators are small dense matrices.
+* :class:`FullSpace` - ``reduction.rule = "none"``: [Phi] selects the dofs not
+  held by the supports (sparse); projected operators stay sparse.  This is the
+  full-order reference the reduced models are measured against.
+
+Either way the transverse supports are satisfied by the space itself, and only
+u(0, t) = V0 t and theta_x(0, t) = Omega t need Lagrange multipliers (70)-(76).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from fenics_drill.model.discretization import BeamDiscretization
+from fenics_drill.model.enrichment import augment, bit_load_responses
+from fenics_drill.model.modes import ModalBasis, select_modes, solve_modes
+from fenics_drill.model.operators import LinearOperators
+
+
+def constraint_scale(tangent, constraints) -> float:
+    """Factor k for the rows of [B] in the saddle system (76): with k [B] the constraint rows
+    have the size of the tangent's, otherwise the system is singular to working precision."""
+    diagonal = np.abs(tangent.diagonal()).max()
+    return diagonal / max(np.abs(np.asarray(constraints)).max(), 1e-300) if diagonal > 0 else 1.0
+
+
+class ModalSpace:
+    """Dense modal basis [Phi] (N_dofs x N_red)."""
+
+    sparse = False
+
+    def __init__(self, phi: np.ndarray):
+        self.phi = np.ascontiguousarray(phi)
+
+    @property
+    def size(self) -> int:
+        return self.phi.shape[1]
+
+    def expand(self, q: np.ndarray) -> np.ndarray:
+        return self.phi @ q
+
+    def project(self, vector: np.ndarray) -> np.ndarray:
+        return self.phi.T @ vector
+
+    def project_matrix(self, matrix: sp.spmatrix) -> np.ndarray:
+        """[Phi]^T A [Phi], touching only the rows of A that hold entries."""
+        A = sp.csr_matrix(matrix)
+        rows = np.flatnonzero(np.diff(A.indptr))
+        if rows.size == 0:
+            return np.zeros((self.size, self.size))
+        return self.phi[rows].T @ (A[rows] @ self.phi)
+
+    def rows(self, dofs: np.ndarray) -> np.ndarray:
+        """The rows of [Phi] of some dofs: maps q to the values of those dofs."""
+        return self.phi[np.asarray(dofs)]
+
+    def zeros_matrix(self) -> np.ndarray:
+        return np.zeros((self.size, self.size))
+
+    def solve(self, matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+        return sla.solve(matrix, rhs, check_finite=False)
+
+    def saddle_solve(self, tangent: np.ndarray, constraints: np.ndarray, rhs_q: np.ndarray, rhs_c: np.ndarray):
+        """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76)."""
+        m = constraints.shape[0]
+        k = constraint_scale(tangent, constraints)
+        system = np.block([[tangent, k * constraints.T], [k * constraints, np.zeros((m, m))]])
+        x = sla.solve(system, np.concatenate([rhs_q, k * rhs_c]), check_finite=False)
+        return x[: self.size], k * x[self.size :]
+
+
+class FullSpace:
+    """Full-order model: [Phi] is the (sparse) selection of the dofs free of supports."""
+
+    sparse = True
+
+    def __init__(self, ndofs: int, support_dofs: np.ndarray):
+        self.free = np.setdiff1d(np.arange(ndofs), support_dofs)
+        self.ndofs = ndofs
+        self.phi = sp.csr_matrix(
+            (np.ones(self.free.size), (self.free, np.arange(self.free.size))), shape=(ndofs, self.free.size)
+        )
+
+    @property
+    def size(self) -> int:
+        return self.free.size
+
+    def expand(self, q: np.ndarray) -> np.ndarray:
+        out = np.zeros(self.ndofs)
+        out[self.free] = q
+        return out
+
+    def project(self, vector: np.ndarray) -> np.ndarray:
+        return np.asarray(vector)[self.free]
+
+    def project_matrix(self, matrix: sp.spmatrix) -> sp.csr_matrix:
+        return sp.csr_matrix(matrix)[self.free][:, self.free]
+
+    def rows(self, dofs: np.ndarray) -> sp.csr_matrix:
+        return self.phi[np.asarray(dofs)]
+
+    def zeros_matrix(self) -> sp.csr_matrix:
+        return sp.csr_matrix((self.size, self.size))
+
+    def solve(self, matrix, rhs: np.ndarray) -> np.ndarray:
+        return spla.spsolve(sp.csc_matrix(matrix), rhs)
+
+    def saddle_solve(self, tangent, constraints, rhs_q: np.ndarray, rhs_c: np.ndarray):
+        """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76), with a sparse LU."""
+        k = constraint_scale(tangent, constraints)
+        B = sp.csr_matrix(k * np.asarray(constraints))
+        system = sp.bmat([[tangent, B.T], [B, None]], format="csc")
+        x = spla.splu(system).solve(np.concatenate([rhs_q, k * rhs_c]))
+        return x[: self.size], k * x[self.size :]
+
+
+def weighted_product(rows_a, weights: np.ndarray, rows_b):
+    """rows_a^T diag(weights) rows_b for dense or sparse rows of [Phi]: the projection of a
+    pointwise (diagonal) Jacobian d F_a / d y_b acting at a set of dofs."""
+    if sp.issparse(rows_b):
+        return rows_a.T @ (sp.diags(weights) @ rows_b)
+    return rows_a.T @ (weights[:, None] * rows_b)
+
+
+def solution_space(scene, disc: BeamDiscretization, operators: LinearOperators):
+    """(space, kept modes, all modes): the modal basis of the scene's reduction rule (Section 6.3),
+    with the static correction for the bit loads if asked, or the full space for 'none'; all
+    modes of the band B (for spectra) either way."""
+    p = disc.properties
+    modes = solve_modes(disc, scene.modal.f_star_max, operators.mass)
+    if scene.reduction.rule == "none":
+        return FullSpace(disc.ndofs, disc.support_dofs), None, modes
+    basis = modes.select(select_modes(modes, scene.reduction, p.length, p.longitudinal_wave_speed))
+    phi = basis.vectors
+    if scene.reduction.static_correction:
+        phi = augment(phi, bit_load_responses(disc, operators), operators.mass)
+    return ModalSpace(phi), basis, modes

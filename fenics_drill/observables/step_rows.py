@@ -1,0 +1,81 @@
+"""One row of observables per accepted step: what ``timeseries.h5`` stores and what a Monte Carlo
+realisation keeps.  :data:`VARIABLES` names them with their units; the point forces add theirs
+(:func:`fenics_drill.model.forces.recorded_variables`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fenics_drill.model.discretization import THETA_X
+from fenics_drill.model.drillstring import DrillstringModel
+from fenics_drill.model.forces import recorded_variables
+from fenics_drill.observables.von_mises import VonMisesProbe
+from fenics_drill.solvers.time_loop import StepRecord
+
+#: name: (units, long name) of every per-step variable that does not belong to a point force.
+STATE_VARIABLES = {
+    "time": ("s", "simulated time"),
+    "dt": ("s", "time step that reached this instant"),
+    "newton_iterations": ("1", "Newton iterations of the step"),
+    "bit_displacement": ("m", "axial displacement of the bit u(L)"),
+    "bit_velocity": ("m/s", "axial velocity of the bit u_dot(L)"),
+    "bit_rotation": ("rad", "rotation of the bit theta_x(L)"),
+    "bit_angular_velocity": ("rad/s", "angular velocity of the bit theta_x_dot(L)"),
+    "lambda_1": ("N", "Lagrange multiplier lambda_1 of (74): -lambda_1 is the force the drive applies at x = 0"),
+    "lambda_4": ("N m", "Lagrange multiplier lambda_4 of (74): -lambda_4 is the torque the drive applies at x = 0"),
+    "impacts": ("1", "vertices whose wall contact began during the step"),
+    "section_v": ("m", "lateral displacement v at the recorded section"),
+    "section_w": ("m", "lateral displacement w at the recorded section"),
+    "section_v_velocity": ("m/s", "lateral velocity v_dot at the recorded section"),
+    "section_w_velocity": ("m/s", "lateral velocity w_dot at the recorded section"),
+    "section_theta_x_velocity": ("rad/s", "angular velocity theta_x_dot at the recorded section"),
+    "max_von_mises": ("Pa", "maximum von Mises stress over the string (NaN if output.von_mises is off)"),
+    "max_von_mises_x": ("m", "x where the maximum von Mises stress sits"),
+    "kinetic_energy": ("J", "kinetic energy, Eq. (24)"),
+    "strain_energy": ("J", "strain energy, Eq. (30)"),
+    "input_work": ("J", "work of the drive since t = 0"),
+    "dissipated_energy": ("J", "energy dissipated since t = 0"),
+}
+
+#: Every per-step variable of a run: the state's and the point forces'.
+VARIABLES = {**STATE_VARIABLES, **recorded_variables()}
+
+
+class StepRows:
+    """Turns a :class:`StepRecord` into a dict of scalars (the bit, the section, the stress, energies,
+    and what each point force records; zeros for the forces the scene leaves off)."""
+
+    def __init__(self, model: DrillstringModel, scene):
+        self.model = model
+        disc = model.disc
+        section = int(np.argmin(np.abs(disc.vertex_x - scene.output.section)))
+        self.section_x = float(disc.vertex_x[section])
+        v_rows, w_rows = model.lateral_rows
+        tx_rows = model.space.rows(disc.vertex_dofs(THETA_X))
+        self.section_rows = (v_rows[[section]], w_rows[[section]], tx_rows[[section]])
+        flags = scene.model
+        self.stress = VonMisesProbe(disc, flags.geometric_nonlinearity, flags.kinematics) \
+            if scene.output.von_mises else None
+        self.absent = {name: 0.0 for name in recorded_variables()}
+
+    def __call__(self, record: StepRecord, dofs: np.ndarray) -> dict:
+        """The row of one step; ``dofs`` is the full-space displacement Phi q of the step."""
+        s = record.state
+        u, du, tx, dtx = self.model.bit_state(s.q, s.qd)
+        v, w, _ = (float((rows @ s.q)[0]) for rows in self.section_rows)
+        dv, dw, dsx = (float((rows @ s.qd)[0]) for rows in self.section_rows)
+        stress, stress_x = self.stress.maximum(dofs) if self.stress is not None else (np.nan, np.nan)
+        budget = record.budget
+        row = {
+            "time": s.t, "dt": record.dt, "newton_iterations": record.newton_iterations,
+            "bit_displacement": u, "bit_velocity": du, "bit_rotation": tx, "bit_angular_velocity": dtx,
+            "lambda_1": s.mu[0], "lambda_4": s.mu[1], "impacts": int(record.onsets.sum()),
+            "section_v": v, "section_w": w, "section_v_velocity": dv, "section_w_velocity": dw,
+            "section_theta_x_velocity": dsx, "max_von_mises": stress, "max_von_mises_x": stress_x,
+            "kinetic_energy": budget.kinetic, "strain_energy": budget.strain,
+            "input_work": budget.input_work, "dissipated_energy": budget.total_dissipated,
+            **self.absent,
+        }
+        for force in self.model.forces:
+            row.update(force.record(record.evaluation.forces[force.name]))
+        return row

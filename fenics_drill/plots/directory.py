@@ -1,0 +1,28 @@
+"""``fenics-drill plot DIR``: the figures of whatever DIR holds - a run, a Monte Carlo study or an
+operating window."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+class NothingToPlot(ValueError):
+    """The directory holds none of the files the figures are drawn from."""
+
+
+def plot_directory(directory: Path, gif: bool = True) -> list[Path]:
+    """Figs. 24-27/36 (optimize.json), 28-35 (statistics.h5) or 13-23 (timeseries.h5); the files written."""
+    if (directory / "optimize.json").exists():
+        from fenics_drill.plots.window import optimize_figures
+
+        return optimize_figures(directory)
+    if (directory / "statistics.h5").exists():
+        from fenics_drill.plots.monte_carlo import mc_figures
+
+        return mc_figures(directory)
+    if (directory / "timeseries.h5").exists():
+        from fenics_drill.plots.run_figures import plot_run
+
+        return plot_run(directory, gif=gif)
+    raise NothingToPlot(f"{directory} holds no timeseries.h5 ('fenics-drill run'), statistics.h5 "
+                        "('fenics-drill mc') or optimize.json ('fenics-drill optimize')")

@@ -1,0 +1,122 @@
+"""Newmark time stepping (67)-(68) solved by Newton with Lagrange multipliers (70)-(76).
+
+gamma = 1/2 + alpha and beta = (1/2 + gamma)^2 / 4 (Section 4.3).  Each step
+solves the saddle-point system (76) for (q_{n+1}, mu_{n+1}) by Newton.  The
+internal tangent (the only assembled matrix) is kept for a number of steps and
+re-assembled after that or after a failed step; the tangents of the force laws
+are fresh at every iteration.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fenics_drill.model.drillstring import DrillstringModel, Evaluation
+from fenics_drill.solvers.newton import saddle_newton
+
+
+class NewtonFailure(RuntimeError):
+    """Newton did not converge within the allowed iterations (or produced non-finite values)."""
+
+
+@dataclass
+class State:
+    """Reduced displacement, velocity, acceleration and multipliers mu (the lambda of (74)) at time t."""
+
+    t: float
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    mu: np.ndarray
+
+
+def newmark_parameters(alpha: float) -> tuple[float, float]:
+    """(gamma, beta) of Section 4.3."""
+    gamma = 0.5 + alpha
+    return gamma, 0.25 * (0.5 + gamma) ** 2
+
+
+class NewmarkNewton:
+    """One Newmark step of (65) with the constraints (72) enforced by multipliers."""
+
+    def __init__(self, model: DrillstringModel, alpha: float, tolerance: float, max_iterations: int,
+                 tangent_reuse: int = 20):
+        """``tangent_reuse``: steps over which an assembled internal tangent is kept (the displacements
+        are small, so it changes slowly; contact and bit-rock tangents are fresh at every iteration)."""
+        self.model = model
+        self.tangent_reuse = tangent_reuse
+        self.gamma, self.beta = newmark_parameters(alpha)
+        self.tolerance, self.max_iterations = tolerance, max_iterations
+        self._internal_parts = None
+        self._steps_since_tangent = 0
+        self._force_level = 0.0
+
+    def constraint_target(self, t: float, h0: np.ndarray) -> np.ndarray:
+        """h(t) of (71) for the rows the basis leaves: u(0, t) = V0 t, theta_x(0, t) = Omega t."""
+        return h0 + self.model.drive_rate * t
+
+    @staticmethod
+    def _scale(ev: Evaluation, mu_force: np.ndarray) -> float:
+        return max(np.linalg.norm(ev.internal), np.linalg.norm(ev.external), np.linalg.norm(mu_force), 1e-30)
+
+    def initial_acceleration(self, q, qd, mu_guess) -> tuple[np.ndarray, np.ndarray]:
+        """qdd(0) and mu(0) from (65) and the twice-differentiated constraint (h'' = 0)."""
+        zero = np.zeros_like(q)
+        ev = self.model.evaluate(q, qd, zero, np.zeros_like(mu_guess), tangent_coefficients=(0.0, 0.0, 1.0))
+        self._internal_parts, self._steps_since_tangent = ev.internal_parts, 0
+        qdd, mu = self.model.space.saddle_solve(ev.tangent, self.model.constraints, -ev.residual,
+                                                np.zeros(len(mu_guess)))
+        return qdd, mu
+
+    def step(self, state: State, dt: float, h0: np.ndarray) -> tuple[State, int, Evaluation]:
+        """Advance by dt; returns the new state, the Newton iterations and the final evaluation.
+
+        Newton (:func:`~fenics_drill.solvers.newton.saddle_newton`) is globalised by backtracking
+        on the residual norm: the bit-rock law (20) has a kink at u_dot_bit = 0 and the wall law (17)
+        one at first contact, where plain Newton can cycle between the two branches.
+        """
+        g, b = self.gamma, self.beta
+        q_pred = state.q + dt * state.qd + dt * dt * (0.5 - b) * state.qdd
+        qd_pred = state.qd + dt * (1.0 - g) * state.qdd
+        c_v, c_a = g / (b * dt), 1.0 / (b * dt * dt)
+        coefficients = (1.0, c_v, c_a)
+        target = self.constraint_target(state.t + dt, h0)
+
+        def rates(q):
+            """(qd, qdd) of (67)-(68) at the end-of-step displacement q."""
+            qdd = (q - q_pred) * c_a
+            return qd_pred + g * dt * qdd, qdd
+
+        def evaluate(q, mu, refresh=False):
+            qd, qdd = rates(q)
+            ev = self.model.evaluate(q, qd, qdd, mu, coefficients,
+                                     internal_parts=None if refresh else self._internal_parts)
+            if refresh:
+                self._internal_parts, self._steps_since_tangent = ev.internal_parts, 0
+            return ev
+
+        def check(iteration, q, mu, ev, norm, gap):
+            if not np.isfinite(norm):
+                raise NewtonFailure(f"Newton produced non-finite values at dt = {dt:.3e} s")
+            # forces can balance to round-off (e.g. M qdd + K q in free vibration): also measure
+            # against the predictor's residual and the force level of earlier steps
+            self._force_level = max(self._force_level, self._scale(ev, self.model.constraints.T @ mu))
+            if norm <= self.tolerance * self._force_level and np.all(
+                np.abs(gap) <= self.tolerance * np.maximum(np.abs(target), 1.0)
+            ):
+                self._steps_since_tangent += 1
+                return State(state.t + dt, q, *rates(q), mu), iteration, ev
+            return None
+
+        q = state.q + dt * state.qd + 0.5 * dt * dt * state.qdd
+        mu = state.mu.copy()
+        stale = self._internal_parts is None or self._steps_since_tangent >= self.tangent_reuse
+        ev = evaluate(q, mu, stale and self.model.internal.state_dependent)
+        self._force_level = max(self._force_level, np.linalg.norm(ev.residual))
+        result = saddle_newton(lambda q, mu: evaluate(q, mu), self.model.space, self.model.constraints, target,
+                               q, mu, ev, check, self.max_iterations)
+        if result is None:
+            raise NewtonFailure(f"Newton did not converge in {self.max_iterations} iterations at dt = {dt:.3e} s")
+        return result

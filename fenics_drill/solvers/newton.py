@@ -1,0 +1,58 @@
+"""Newton's method on the saddle-point system (76), shared by the static solver and the Newmark step.
+
+Each iteration solves [[J, B^T], [B, 0]] (dq, dmu) = -(r, [B] q - h) in the
+solution space and takes the largest step of a backtracking line search on the
+residual norm (Armijo's sufficient decrease).  The wall law (17) has a kink at first
+contact and the bit-rock law (20) one at u_dot_bit = 0; a full Newton update can jump
+from one branch to the other and back forever, and halving the update until the
+residual norm decreases stops that.  What counts as converged is the caller's.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+#: Halvings of a Newton update before the last one is taken anyway.
+HALVINGS = 6
+#: Sufficient decrease: accept when |r(step)| < (1 - ARMIJO step) |r(0)|.
+ARMIJO = 1e-4
+
+
+def backtrack(trial, norm0: float, step: float = 1.0):
+    """Largest step = step / 2^k (k < HALVINGS) whose ``trial(step) -> (norm, payload)`` decreases
+    the norm enough; returns (step, norm, payload) of the accepted (or last) trial."""
+    for _ in range(HALVINGS):
+        norm, payload = trial(step)
+        if norm < (1.0 - ARMIJO * step) * norm0:
+            break
+        step *= 0.5
+    return step, norm, payload
+
+
+def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np.ndarray, q: np.ndarray,
+                  mu: np.ndarray, evaluation, check: Callable, max_iterations: int,
+                  first_step: Callable[[np.ndarray], float] | None = None):
+    """Iterate from (q, mu), whose ``evaluation`` (with ``.residual`` and ``.tangent``) is given.
+
+    ``evaluate(q, mu)`` evaluates a trial state.  Before each update
+    ``check(iteration, q, mu, evaluation, norm, gap)`` returns the result to stop with,
+    or None to go on (it may raise).  ``first_step(dq)`` caps the first trial step of the
+    line search (default 1).  Returns None when ``max_iterations`` updates did not satisfy ``check``.
+    """
+    norm = np.linalg.norm(evaluation.residual)
+    for iteration in range(1, max_iterations + 1):
+        gap = constraints @ q - target
+        verdict = check(iteration, q, mu, evaluation, norm, gap)
+        if verdict is not None:
+            return verdict
+        dq, dmu = space.saddle_solve(evaluation.tangent, constraints, -evaluation.residual, -gap)
+
+        def trial(step):
+            result = evaluate(q + step * dq, mu + step * dmu)
+            return np.linalg.norm(result.residual), result
+
+        step, norm, evaluation = backtrack(trial, norm, 1.0 if first_step is None else first_step(dq))
+        q, mu = q + step * dq, mu + step * dmu
+    return None

@@ -1,0 +1,121 @@
+"""Static equilibrium under gravity with wall contact (Section 6.4).
+
+The paper reaches it by integrating the dynamics from rest with V0 = Omega = 0;
+here Newton solves  f_int(q, 0, 0) = f_G + f_FS(q, 0)  with u(0) = theta_x(0) = 0
+directly, in the same solution space as the dynamics so that the drilling run
+starts from an equilibrium of its own model.  Each Newton update is limited so
+that no vertex moves laterally by more than a quarter of the gap: from the
+straight string the linear sag is orders of magnitude larger than the gap.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fenics_drill.model.drillstring import DrillstringModel
+from fenics_drill.solvers.newton import saddle_newton
+
+#: Contact stiffness continuation: the wall springs are scaled by these factors in turn,
+#: each stage starting from the previous equilibrium (10^-4 to 1 in steps of 10^0.25).  A soft wall lets the string settle
+#: onto it smoothly; stiffening then moves it by tiny amounts Newton handles well.
+STIFFNESS_STAGES = tuple(10.0 ** (-0.25 * k) for k in range(16, -1, -1))
+
+#: Largest lateral move of any vertex per Newton update, as a fraction of the gap.
+STEP_LIMIT = 0.25
+
+#: Newton on the kink of the wall law (17) at zero indentation can cycle between contact sets
+#: when hundreds of vertices rest on the wall (a 1000 m string).  If the relative residual has
+#: not halved for STALL_ITERATIONS iterations and is below STALL_TOLERANCE (1e-6 of the weight:
+#: about 1 N for a 1000 m string), the best iterate is taken; the report gives its residual.
+STALL_TOLERANCE = 1e-6
+STALL_ITERATIONS = 20
+
+
+class StaticFailure(RuntimeError):
+    """Newton found no equilibrium within the allowed iterations."""
+
+
+@dataclass
+class StaticEquilibrium:
+    q: np.ndarray
+    mu: np.ndarray
+    iterations: int
+    residual: float  # relative
+
+
+def solve_static(model: DrillstringModel, tolerance: float = 1e-8, max_iterations: int = 200) -> StaticEquilibrium:
+    """Equilibrium of the string at rest (velocities zero, so no friction and no bit-rock force).
+
+    With wall contact, the wall springs are stiffened stage by stage (:data:`STIFFNESS_STAGES`)
+    on copies of the model; the model itself is left as it was."""
+    q, mu = np.zeros(model.size), np.zeros(2)
+    wall = model.force("wall")
+    if wall is None:
+        return _newton(model, q, mu, tolerance, max_iterations)
+    iterations = 0
+    for factor in STIFFNESS_STAGES:
+        stage = model.with_force(wall.with_stiffness_scale(factor))
+        eq = _newton(stage, q, mu, tolerance if factor == 1.0 else 1e-6, max_iterations)
+        q, mu, iterations = eq.q, eq.mu, iterations + eq.iterations
+    return StaticEquilibrium(q, mu, iterations, eq.residual)
+
+
+def _newton(model: DrillstringModel, q, mu, tolerance: float, max_iterations: int) -> StaticEquilibrium:
+    zero = np.zeros(model.size)
+    lateral_v, lateral_w = model.lateral_rows
+    step_limit = STEP_LIMIT * model.gap if model.force("wall") is not None else np.inf
+
+    def evaluate(q, mu):
+        return model.evaluate(q, zero, zero, mu, tangent_coefficients=(1.0, 0.0, 0.0))
+
+    best = [np.inf, q, mu, 0]  # relative residual, q, mu, iteration of the last halving
+    last = [np.inf]
+
+    def check(iteration, q, mu, ev, norm, gap):
+        scale = max(np.linalg.norm(ev.internal), np.linalg.norm(ev.external), 1e-30)
+        relative = last[0] = norm / scale
+        if relative <= tolerance and np.all(np.abs(gap) <= tolerance):
+            return StaticEquilibrium(q, mu, iteration, relative)
+        if relative <= 0.5 * best[0]:
+            best[:] = [relative, q, mu, iteration]
+        elif iteration - best[3] >= STALL_ITERATIONS and best[0] <= STALL_TOLERANCE:
+            return StaticEquilibrium(best[1], best[2], iteration, best[0])
+        return None
+
+    def first_step(dq):
+        move = max(np.max(np.abs(lateral_v @ dq)), np.max(np.abs(lateral_w @ dq)))
+        return min(1.0, step_limit / move) if move > 0 else 1.0
+
+    result = saddle_newton(evaluate, model.space, model.constraints, np.zeros(2), q, mu, evaluate(q, mu), check,
+                           max_iterations, first_step)
+    if result is None:
+        raise StaticFailure(f"static equilibrium not found in {max_iterations} Newton iterations "
+                            f"(relative residual {last[0]:.2e})")
+    return result
+
+
+def static_report(model: DrillstringModel, eq: StaticEquilibrium) -> dict:
+    """max_sag [m], contact vertices and forces: what ``fenics-drill static`` writes to static.json."""
+    v, w = (rows @ eq.q for rows in model.lateral_rows)
+    x = model.disc.vertex_x
+    p = model.disc.properties
+    report = {
+        "max_sag": float(np.max(-w)),
+        "max_sag_position": float(x[np.argmax(-w)]),
+        "max_lateral_displacement": float(np.max(np.hypot(v, w))),
+        "gap": model.gap,
+        "weight": p.density * p.section.area * p.gravity * p.length,
+        "newton_iterations": eq.iterations,
+        "relative_residual": eq.residual,
+        "contact_vertices": [],
+    }
+    wall = model.force("wall")
+    if wall is not None:
+        forces = wall.evaluate(eq.q, np.zeros_like(eq.q))
+        active = forces.in_contact
+        report["contact_vertices"] = [float(xi) for xi in x[active]]
+        report["contact_force_total"] = float(-np.sum(forces.normal))
+        report["max_penetration"] = float(np.max(forces.indentation[active])) if active.any() else 0.0
+    return report

@@ -1,0 +1,66 @@
+"""Time-step control: nominal step of Section 6.2, refined where impacts make the motion rough.
+
+The local error of a Newmark step is estimated as in Zienkiewicz & Xie (1991):
+e = (beta - 1/6) dt^2 (qdd_{n+1} - qdd_n), measured on the lateral displacements of
+the vertices (where impacts act) against ``time.error_tolerance``.  An impact
+makes the acceleration jump, the estimate grows and the step shrinks; once the
+motion is smooth again the step relaxes back to the nominal one.  A Newton
+failure halves the step; after ``time.max_step_cuts`` halvings the run stops.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class StepTooSmall(RuntimeError):
+    """The step would have to go below dt_nominal / 2^max_step_cuts."""
+
+
+def nominal_step(scene) -> float:
+    """time.dt, or 1 / (2 f_max) with f_max = f*_max c_L / L (Section 6.2)."""
+    if scene.time.dt > 0:
+        return scene.time.dt
+    p = scene.beam_properties
+    f_max = scene.modal.f_star_max * p.longitudinal_wave_speed / p.length
+    return 1.0 / (2.0 * f_max)
+
+
+class StepController:
+    """Proposes the next step size and judges each finished step."""
+
+    GROWTH_MAX, SHRINK_MIN, SAFETY = 2.0, 0.25, 0.9
+
+    def __init__(self, scene, beta: float, lateral_rows):
+        self.nominal = nominal_step(scene)
+        self.minimum = self.nominal / 2 ** scene.time.max_step_cuts
+        self.adaptive = scene.time.adaptive
+        self.tolerance = scene.time.error_tolerance
+        self.error_factor = abs(beta - 1.0 / 6.0)
+        self.lateral_rows = lateral_rows
+        self.dt = self.nominal
+
+    def error_ratio(self, dt: float, qdd_old: np.ndarray, qdd_new: np.ndarray) -> float:
+        """Estimated local error over the tolerance (<= 1: accept)."""
+        e = self.error_factor * dt * dt * (qdd_new - qdd_old)
+        return max(float(np.max(np.abs(rows @ e))) for rows in self.lateral_rows) / self.tolerance
+
+    def judge(self, dt: float, ratio: float) -> bool:
+        """Accept or reject a converged step and set the next proposal."""
+        if not self.adaptive:
+            self.dt = self.nominal
+            return True
+        factor = self.SAFETY * max(ratio, 1e-12) ** (-1.0 / 3.0)
+        accept = ratio <= 1.0 or dt <= self.minimum * (1 + 1e-9)
+        factor = min(self.GROWTH_MAX, max(self.SHRINK_MIN, factor))
+        self.dt = min(self.nominal, max(self.minimum, dt * factor))
+        return accept
+
+    def cut(self, dt: float, reason: str, t: float) -> None:
+        """Halve after a Newton failure, or stop with a message saying when and why."""
+        if dt <= self.minimum * (1 + 1e-9):
+            raise StepTooSmall(
+                f"at t = {t:.6f} s: {reason}; the step is already at its minimum "
+                f"{self.minimum:.3e} s (time.max_step_cuts halvings of {self.nominal:.3e} s)"
+            )
+        self.dt = max(self.minimum, 0.5 * dt)

@@ -1,0 +1,120 @@
+"""The time loop of a drilling run: static start (Section 6.4), initial conditions (Section 3.2),
+adaptive Newmark/Newton steps, impact counting and the energy budget.
+
+It knows nothing about files: every accepted step is handed to ``on_step`` as a
+:class:`StepRecord`, and the I/O layer decides what to keep.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from fenics_drill.model.drillstring import DrillstringModel, Evaluation
+from fenics_drill.solvers.energy_budget import EnergyBudget, PowerTerms
+from fenics_drill.solvers.newmark import NewmarkNewton, NewtonFailure, State
+from fenics_drill.solvers.step_control import StepController
+
+
+@dataclass
+class StepRecord:
+    """What an observer may want of one accepted step."""
+
+    state: State
+    dt: float
+    newton_iterations: int
+    evaluation: Evaluation
+    onsets: np.ndarray  # vertices whose contact began during the step (bool per vertex)
+    in_contact: np.ndarray  # vertices in contact at the end of the step
+    budget: EnergyBudget
+    step_index: int
+
+
+class Simulation:
+    """Integrates one scene's model from a given initial displacement."""
+
+    def __init__(self, model: DrillstringModel, scene):
+        self.model, self.scene = model, scene
+        solver = scene.solver
+        self.stepper = NewmarkNewton(model, scene.time.newmark_alpha, solver.newton_tolerance,
+                                     solver.newton_max_iterations, solver.tangent_reuse)
+        self.controller = StepController(scene, self.stepper.beta, model.lateral_rows)
+        n_vertices = len(model.disc.vertex_x)
+        self.impacts_per_vertex = np.zeros(n_vertices, dtype=np.int64)
+        self.stats = {"steps": 0, "rejected_steps": 0, "newton_failures": 0, "newton_iterations": 0,
+                      "min_dt": np.inf, "max_dt": 0.0}
+        self.last_state: State | None = None  # the latest accepted state (what an interrupted run keeps)
+
+    def initial_state(self, q0: np.ndarray, mu0: np.ndarray) -> State:
+        """Displacement q0 (the static equilibrium), velocity (V0, Omega) of Section 3.2, and the
+        consistent acceleration and multipliers."""
+        qd0 = self.model.drive_velocity_field()
+        qdd0, mu = self.stepper.initial_acceleration(q0, qd0, mu0)
+        return State(0.0, q0, qd0, qdd0, mu)
+
+    def _power_terms(self, state: State, ev: Evaluation) -> PowerTerms:
+        return PowerTerms(
+            drive=-state.mu,
+            drive_displacement=self.model.constraints @ state.q,
+            damping=self.model.internal.damping_force(state.qd),
+            forces={f.name: ev.forces[f.name].dissipative for f in self.model.forces if not f.conservative},
+        )
+
+    def mechanical_energy(self, state: State, ev: Evaluation) -> tuple[float, float, float]:
+        """Kinetic, strain, and potential (of the point forces: gravity, wall springs) energies."""
+        kinetic = self.model.internal.kinetic_energy(state.q, state.qd)
+        strain = self.model.internal.strain_energy(state.q)
+        return kinetic, strain, self.model.potential_energy(ev)
+
+    def _contact(self, ev: Evaluation, previous: np.ndarray) -> np.ndarray:
+        """Vertices in contact with the wall at an evaluated state (``previous`` when contact is off)."""
+        wall = ev.forces.get("wall")
+        return wall.in_contact if wall is not None else previous
+
+    def run(self, state: State, t_end: float, on_step=None, progress=None) -> State:
+        """Step from ``state`` to t_end; raises StepTooSmall (with when and why) if the step collapses.
+
+        ``on_step`` sees the initial state (step_index 0) and then every accepted step."""
+        model = self.model
+        ev = model.evaluate(state.q, state.qd, state.qdd, state.mu)
+        h0 = model.constraints @ state.q - model.drive_rate * state.t
+        budget = EnergyBudget(initial_energy=sum(self.mechanical_energy(state, ev)))
+        budget.record(*self.mechanical_energy(state, ev))
+        self.budget = budget
+        powers = self._power_terms(state, ev)
+        in_contact = self._contact(ev, np.zeros(len(self.impacts_per_vertex), bool))
+        clock = time.perf_counter()
+        self.last_state = state
+        if on_step is not None:
+            on_step(StepRecord(state, 0.0, 0, ev, np.zeros_like(in_contact), in_contact, budget, 0))
+        while state.t < t_end * (1 - 1e-12):
+            dt = min(self.controller.dt, t_end - state.t)
+            try:
+                new, iterations, new_ev = self.stepper.step(state, dt, h0)
+            except NewtonFailure as failure:
+                self.stats["newton_failures"] += 1
+                self.controller.cut(dt, str(failure), state.t)
+                continue
+            self.stats["newton_iterations"] += iterations
+            ratio = self.controller.error_ratio(dt, state.qdd, new.qdd)
+            if not self.controller.judge(dt, ratio):
+                self.stats["rejected_steps"] += 1
+                continue
+            new_powers = self._power_terms(new, new_ev)
+            budget.advance(powers, new_powers, new.q - state.q)
+            budget.record(*self.mechanical_energy(new, new_ev))
+            new_contact = self._contact(new_ev, in_contact)
+            onsets = new_contact & ~in_contact
+            self.impacts_per_vertex += onsets
+            self.stats["steps"] += 1
+            self.stats["min_dt"] = min(self.stats["min_dt"], dt)
+            self.stats["max_dt"] = max(self.stats["max_dt"], dt)
+            state, ev, powers, in_contact = new, new_ev, new_powers, new_contact
+            self.last_state = state
+            if on_step is not None:
+                on_step(StepRecord(state, dt, iterations, ev, onsets, in_contact, budget, self.stats["steps"]))
+            if progress is not None:
+                progress(state.t, t_end, self.stats, dt, time.perf_counter() - clock)
+        return state

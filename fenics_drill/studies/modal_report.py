@@ -1,0 +1,47 @@
+"""``fenics-drill modal``: the modal analysis of a scene as a JSON-ready report (DIR/modes.json)."""
+
+from __future__ import annotations
+
+from fenics_drill.forms import FIELD_NAMES
+from fenics_drill.model.discretization import BeamDiscretization
+from fenics_drill.model.modes import ModalBasis, family_counts, select_modes, solve_modes
+
+
+def scene_modes(scene) -> tuple[BeamDiscretization, ModalBasis, list[int]]:
+    """Discretization, all modes in the band of analysis, and the indices the reduction keeps."""
+    disc = BeamDiscretization.from_scene(scene)
+    basis = solve_modes(disc, scene.modal.f_star_max)
+    p = disc.properties
+    kept = select_modes(basis, scene.reduction, p.length, p.longitudinal_wave_speed)
+    return disc, basis, [int(i) for i in kept]
+
+
+def modal_report(scene) -> dict:
+    """full_dofs, every mode (frequency_hz, f_star, kind, energy fractions) and the reduced basis."""
+    disc, basis, kept = scene_modes(scene)
+    modes = [
+        {
+            "frequency_hz": float(f),
+            "f_star": float(fs),
+            "kind": kind,
+            "energy_fractions": dict(zip(FIELD_NAMES, map(float, fr))),
+        }
+        for f, fs, kind, fr in zip(basis.frequencies_hz, basis.f_star, basis.kinds, basis.energy_fractions)
+    ]
+    reduced = {
+        "rule": scene.reduction.rule,
+        "size": len(kept),
+        "counts": family_counts(basis.kinds[i] for i in kept),
+        "mode_indices": kept,
+    }
+    if scene.reduction.rule == "none":  # full order: the FE space itself, no modal basis
+        reduced = {"rule": "none", "size": disc.ndofs, "counts": None, "mode_indices": None}
+    return {
+        "full_dofs": disc.ndofs,
+        "element_degree": disc.element_degree,
+        "elements": disc.elements,
+        "supports": disc.supports,
+        "longitudinal_wave_speed": disc.properties.longitudinal_wave_speed,
+        "modes": modes,
+        "reduced_basis": reduced,
+    }

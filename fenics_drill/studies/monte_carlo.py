@@ -1,0 +1,60 @@
+"""``fenics-drill mc``: Monte Carlo over the random bit-rock laws (Sections 5 and 6.11).
+
+Every process prepares the scene once (model and static equilibrium:
+:func:`fenics_drill.studies.prepare.prepare`; neither depends on the bit-rock
+parameters), then runs its share of the realisations: realisation k on rank k mod P,
+with parameters drawn from ``default_rng([seed, k])``.  Each finished realisation is
+written at once (:mod:`fenics_drill.io.realisations`); ``--resume`` skips those
+present.  When all are done, rank 0 reads them in index order and writes the
+statistics (:mod:`fenics_drill.studies.statistics`), so the result does not depend
+on the number of processes.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from fenics_drill.io.realisations import NOMINAL, read_realisation, realisation_path, write_realisation
+from fenics_drill.io.study_directory import all_done, claim
+from fenics_drill.studies.prepare import prepare, run_realisation
+from fenics_drill.studies.statistics import write_statistics
+from fenics_drill.studies.uncertainty import BitRockLaws
+
+
+def _progress(out: Path, samples: int, started: float, done_at_start: int) -> None:
+    files = sorted((out / "realisations").glob("*.h5"))
+    done = len(files)
+    total_q = sum(read_realisation(p, histories=False)["q_norm_integral"] for p in files)
+    metric = np.sqrt(total_q / done) if done else float("nan")
+    rate = (done - done_at_start) / (time.perf_counter() - started)
+    eta = (samples - done) / rate if rate > 0 else float("nan")
+    sys.stderr.write(f"\r  realisations {done:5d} / {samples}  conv_MC {metric:.6e}  eta {eta:8.0f} s ")
+    sys.stderr.flush()
+
+
+def monte_carlo(scene, samples: int, out: str | Path, resume: bool = False, progress: bool = True,
+                comm=MPI.COMM_WORLD) -> dict | None:
+    """Run (or finish) the study; rank 0 returns the summary, the other ranks None."""
+    out = Path(out)
+    laws = BitRockLaws(scene.bit_rock, scene.uncertainty)  # refuses inadmissible laws
+    claim(out, scene.to_dict(), "realisations", "*.h5", resume, comm)
+    prepared = prepare(scene)
+    if comm.rank == 0 and not (out / NOMINAL).exists():
+        write_realisation(out / NOMINAL, run_realisation(prepared, scene))
+    done_at_start = len(list((out / "realisations").glob("*.h5")))
+    started = time.perf_counter()
+    for k in range(comm.rank, samples, comm.size):
+        path = realisation_path(out, k)
+        if path.exists():
+            continue
+        write_realisation(path, run_realisation(prepared, scene.with_changes(bit_rock=laws.sample(k))))
+        if progress and comm.rank == 0:
+            _progress(out, samples, started, done_at_start)
+    if not all_done(comm, progress):
+        return None
+    return write_statistics(out, samples)

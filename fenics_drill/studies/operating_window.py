@@ -1,0 +1,154 @@
+"""``fenics-drill optimize``: the operating window of Sections 6.9, 6.10 and 6.12.
+
+The window (V0, Omega) is a structured grid (``optimize.axial_velocity``,
+``optimize.rotation_speed``).  Deterministic mode (``optimize.samples = 0``): one
+drilling run per point with the nominal bit-rock law; objective rop (99) or
+efficiency (96); admissible where UTS - max sigma_VM >= 0 (100).  Robust mode
+(``samples = N``): N realisations per point of the random bit-rock laws (Section 5),
+the same N parameter draws at every point (common random numbers, so that the map
+compares operating points and not samples); objective E[objective] (102); admissible
+where the estimate of P{UTS - max sigma_VM >= 0} is >= 1 - P_risk (103)-(104).
+
+Work is spread over MPI ranks by (point, realisation) pairs, each result written at
+once to ``DIR/points/PPPP_KKKK.json`` (atomically); ``--resume`` skips those present,
+exactly like ``fenics-drill mc``.  Rank 0 assembles ``DIR/optimize.json``.
+
+The model and its static equilibrium are built once per rank: neither depends on the
+drive speeds nor on the bit-rock parameters.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+from scipy import interpolate, optimize
+
+from fenics_drill.io.study_directory import all_done, claim, write_atomic
+from fenics_drill.studies.prepare import prepare, run_realisation
+from fenics_drill.studies.uncertainty import BitRockLaws
+
+NOMINAL_DRAW = -1
+
+
+def grid_axis(spec: list) -> np.ndarray:
+    low, high, n = spec
+    return np.linspace(low, high, int(n))
+
+
+def chance_constraint(max_stress: np.ndarray, ultimate_strength: float, risk: float) -> tuple[float, bool]:
+    """(estimate of P{UTS - max sigma_VM >= 0}, whether it is >= 1 - P_risk), Eqs. (103)-(104)."""
+    probability = float(np.mean(np.asarray(max_stress) <= ultimate_strength))
+    return probability, probability >= 1.0 - risk
+
+
+def _task_path(out: Path, point: int, draw: int) -> Path:
+    return out / "points" / f"{point:04d}_{'nominal' if draw == NOMINAL_DRAW else f'{draw:04d}'}.json"
+
+
+def _evaluate(prepared, scene, v0: float, omega: float, bit_rock: dict) -> dict:
+    point_scene = scene.with_changes(drive={"axial_velocity": v0, "rotation_speed": omega}, bit_rock=bit_rock)
+    r = run_realisation(prepared, point_scene)
+    return {"status": r["status"], "message": r["message"], "rop": r["rop"], "signed_rop": r["signed_rop"],
+            "efficiency": r["efficiency"], "max_von_mises": r["max_von_mises"], "bit_rock": bit_rock,
+            "wall_time_s": r["wall_time_s"]}
+
+
+def _refine(v0: np.ndarray, omega: np.ndarray, values: np.ndarray, start: tuple[int, int]) -> dict | None:
+    """Maximise a cubic (or lower) spline interpolant of the objective over the window, from the grid optimum."""
+    if len(v0) < 2 or len(omega) < 2 or not np.isfinite(values).all():
+        return None
+    spline = interpolate.RectBivariateSpline(v0, omega, values, kx=min(3, len(v0) - 1), ky=min(3, len(omega) - 1))
+    scale = np.array([v0[-1] - v0[0], omega[-1] - omega[0]])
+    lower = np.array([v0[0], omega[0]])
+
+    def negative(z):
+        x = lower + z * scale
+        return -float(spline(x[0], x[1])[0, 0])
+
+    z0 = (np.array([v0[start[0]], omega[start[1]]]) - lower) / scale
+    best = optimize.minimize(negative, z0, bounds=[(0, 1), (0, 1)], method="L-BFGS-B")
+    x = lower + best.x * scale
+    return {"axial_velocity": float(x[0]), "rotation_speed": float(x[1]), "objective": -float(best.fun)}
+
+
+def assemble(scene, out: Path) -> dict:
+    """Read every point's results and write DIR/optimize.json: grids, maps, admissible mask, optimum."""
+    opt = scene.optimize
+    v0, omega = grid_axis(opt.axial_velocity), grid_axis(opt.rotation_speed)
+    draws = [NOMINAL_DRAW] if opt.samples == 0 else list(range(opt.samples))
+    shape = (len(v0), len(omega))
+    maps = {key: np.full(shape, np.nan) for key in ("rop", "signed_rop", "efficiency", "max_von_mises",
+                                                     "constraint_probability")}
+    failed = 0
+    for i in range(len(v0)):
+        for j in range(len(omega)):
+            results = [json.loads(_task_path(out, i * len(omega) + j, d).read_text()) for d in draws]
+            finished = [r for r in results if r["status"] == "finished"]
+            failed += len(results) - len(finished)
+            if not finished:
+                continue
+            for key in ("rop", "signed_rop", "efficiency"):
+                maps[key][i, j] = np.mean([r[key] for r in finished])  # E[.] of (102); the value itself if N = 0
+            stresses = np.array([r["max_von_mises"] for r in finished])
+            maps["max_von_mises"][i, j] = stresses.max()
+            maps["constraint_probability"][i, j] = chance_constraint(stresses, opt.ultimate_strength,
+                                                                     opt.risk)[0]
+    if opt.samples == 0:
+        admissible = maps["max_von_mises"] <= opt.ultimate_strength  # (100)
+    else:
+        admissible = maps["constraint_probability"] >= 1.0 - opt.risk  # (104)
+    objective = maps[opt.objective]
+    candidates = np.where(admissible & np.isfinite(objective), objective, -np.inf)
+    report = {
+        "mode": "deterministic" if opt.samples == 0 else f"robust ({opt.samples} realisations per point)",
+        "objective": opt.objective, "ultimate_strength": opt.ultimate_strength, "risk": opt.risk,
+        "axial_velocity": v0.tolist(), "rotation_speed": omega.tolist(), "t_end": scene.time.t_end,
+        **{key: value.tolist() for key, value in maps.items()},
+        "admissible": admissible.tolist(), "failed_runs": failed,
+    }
+    if np.isfinite(candidates).any():
+        i, j = np.unravel_index(int(np.argmax(candidates)), shape)
+        report["feasible"] = True
+        report["optimum"] = {"axial_velocity": float(v0[i]), "rotation_speed": float(omega[j]),
+                             "objective": float(objective[i, j]), "max_von_mises": float(maps["max_von_mises"][i, j])}
+        report["refined_optimum"] = _refine(v0, omega, objective, (i, j)) if admissible.all() else None
+    else:
+        report["feasible"] = False
+        report["optimum"] = None
+        report["message"] = ("no admissible point in the window: the von Mises constraint "
+                             f"({'(100)' if opt.samples == 0 else '(104)'}) fails everywhere")
+    (out / "optimize.json").write_text(json.dumps(report, indent=1, default=float))
+    return report
+
+
+def run_optimize(scene, out: str | Path, resume: bool = False, progress: bool = True,
+                 comm=MPI.COMM_WORLD) -> dict | None:
+    """Evaluate the window (spread over the ranks) and assemble the report on rank 0."""
+    out = Path(out)
+    opt = scene.optimize
+    laws = BitRockLaws(scene.bit_rock, scene.uncertainty) if opt.samples > 0 else None
+    v0, omega = grid_axis(opt.axial_velocity), grid_axis(opt.rotation_speed)
+    draws = [NOMINAL_DRAW] if opt.samples == 0 else list(range(opt.samples))
+    tasks = [(i * len(omega) + j, v0[i], omega[j], d) for i in range(len(v0)) for j in range(len(omega)) for d in draws]
+    claim(out, scene.to_dict(), "points", "*.json", resume, comm)
+    prepared = prepare(scene)
+    started = time.perf_counter()
+    for n, (point, a, b, draw) in enumerate(tasks):
+        if n % comm.size != comm.rank or _task_path(out, point, draw).exists():
+            continue
+        bit_rock = dataclasses.asdict(scene.bit_rock) if draw == NOMINAL_DRAW else laws.sample(draw)
+        result = _evaluate(prepared, scene, a, b, bit_rock)
+        write_atomic(_task_path(out, point, draw), lambda tmp: tmp.write_text(json.dumps(result, default=float)))
+        if progress and comm.rank == 0:
+            done = len(list((out / "points").glob("*.json")))
+            sys.stderr.write(f"\r  runs {done:5d} / {len(tasks)}  wall {time.perf_counter() - started:8.1f} s ")
+            sys.stderr.flush()
+    if not all_done(comm, progress):
+        return None
+    return assemble(scene, out)

@@ -1,0 +1,179 @@
+"""``fenics-drill run`` and ``fenics-drill static``: a scene in, files out.
+
+run: DIR/summary.json, DIR/timeseries.h5 (see :mod:`fenics_drill.io.timeseries`),
+DIR/fields.xdmf (u, v, w, theta_x, theta_y, theta_z on P1 every
+``output.field_interval`` seconds).  The summary is written however the run
+ends (finished, failed with the reason, or interrupted with Ctrl-C) and says which.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from fenics_drill.io.fields import FieldWriter
+from fenics_drill.io.json_files import write_json
+from fenics_drill.io.timeseries import TimeSeriesWriter, read_series
+from fenics_drill.model.drillstring import DrillstringModel, build_model
+from fenics_drill.observables.drilling_quantities import drilling_quantities
+from fenics_drill.observables.step_rows import StepRows
+from fenics_drill.solvers.static import StaticFailure, solve_static, static_report
+from fenics_drill.solvers.step_control import StepTooSmall, nominal_step
+from fenics_drill.solvers.time_loop import Simulation, StepRecord
+from fenics_drill.studies.prepare import prepare
+
+
+def run_static(scene, out: str | Path) -> dict:
+    """Static equilibrium of the scene (Section 6.4): DIR/static.json and DIR/static.xdmf."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    model = build_model(scene)
+    equilibrium = solve_static(model)
+    report = static_report(model, equilibrium)
+    report["reduced_size"] = model.size
+    writer = FieldWriter(model.disc, out / "static.xdmf")
+    writer.write(model.space.expand(equilibrium.q), 0.0)
+    writer.close()
+    write_json(out / "static.json", report)
+    return report
+
+
+class Progress:
+    """One line on stderr every few seconds: simulated time, steps, step size, wall time, ETA."""
+
+    def __init__(self, enabled: bool, every_s: float = 2.0):
+        self.enabled, self.every_s, self.last = enabled, every_s, -np.inf
+
+    def __call__(self, t, t_end, stats, dt, wall):
+        if not self.enabled or (wall - self.last < self.every_s and t < t_end):
+            return
+        self.last = wall
+        eta = wall * (t_end - t) / t if t > 0 else float("nan")
+        sys.stderr.write(
+            f"\r  t = {t:8.4f} / {t_end:g} s ({100 * t / t_end:5.1f}%)  steps {stats['steps']:7d}  "
+            f"dt {dt:.2e} s  wall {wall:7.1f} s  eta {eta:7.1f} s"
+        )
+        if t >= t_end * (1 - 1e-12):
+            sys.stderr.write("\n")
+        sys.stderr.flush()
+
+
+class RunRecorder:
+    """Turns accepted steps (and the initial state) into time-series rows and XDMF snapshots."""
+
+    def __init__(self, model: DrillstringModel, scene, out: Path):
+        self.model = model
+        self.rows = StepRows(model, scene)
+        self.section_x = self.rows.section_x
+        self.series = TimeSeriesWriter(out / "timeseries.h5", model.disc.vertex_x, {
+            "section_x": self.section_x, "gap": model.gap, "scene": json.dumps(scene.to_dict()),
+            "reduced_size": model.size,
+        }, model.modes)
+        self.field_interval = scene.output.field_interval
+        self.fields = FieldWriter(model.disc, out / "fields.xdmf", with_stress=self.rows.stress is not None) \
+            if self.field_interval > 0 else None
+        self.next_field_time = 0.0
+        self.last_state = None  # the latest state whose row is in the series (what an interrupted run reports)
+
+    def _write_fields(self, t: float, dofs: np.ndarray) -> None:
+        if self.fields is not None and t >= self.next_field_time - 1e-12:
+            stress = self.rows.stress.cell_stress(dofs) if self.rows.stress is not None else None
+            self.fields.write(dofs, t, stress)
+            self.next_field_time = self.field_interval * (np.floor(t / self.field_interval + 1e-9) + 1)
+
+    def __call__(self, record: StepRecord) -> None:
+        dofs = self.model.space.expand(record.state.q)
+        self.series.append(self.rows(record, dofs))
+        self.last_state = record.state
+        self._write_fields(record.state.t, dofs)
+
+    def close(self, impacts_per_vertex: np.ndarray) -> None:
+        self.series.close(impacts_per_vertex)
+        if self.fields is not None:
+            self.fields.close()
+
+
+def run_scene(scene, out: str | Path, progress: bool = True) -> dict:
+    """Static equilibrium, then the drilling dynamics to time.t_end; returns the summary."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    clock = time.perf_counter()
+    summary: dict = {"status": "failed", "message": "", "t_end": 0.0, "steps": 0}
+    recorder = simulation = None
+    try:
+        prepared = prepare(scene)
+        model, equilibrium = prepared.model, prepared.equilibrium
+        summary["reduced_size"], summary["full_dofs"] = model.size, model.disc.ndofs
+        summary["setup_time_s"], summary["static"] = prepared.setup_time_s, prepared.static
+        simulation = Simulation(model, scene)
+        start = simulation.initial_state(equilibrium.q, equilibrium.mu)
+        recorder = RunRecorder(model, scene, out)
+        u0 = model.bit_state(start.q, start.qd)[0]
+        summary["nominal_dt"] = nominal_step(scene)
+        loop_clock = time.perf_counter()
+        try:
+            final = simulation.run(start, scene.time.t_end, recorder, Progress(progress))
+            summary["status"], summary["message"] = "finished", "reached time.t_end"
+        except StepTooSmall as failure:
+            final = None
+            summary["message"] = str(failure)
+        summary["integration_time_s"] = time.perf_counter() - loop_clock
+        last = final if final is not None else simulation.last_state
+        summary.update(_dynamics_summary(model, simulation, recorder, last, u0))
+    except KeyboardInterrupt:
+        summary["status"], summary["message"] = "interrupted", "stopped by Ctrl-C or SIGTERM"
+        if recorder is not None and recorder.last_state is not None:
+            summary.update(_dynamics_summary(model, simulation, recorder, recorder.last_state, u0))
+    except StaticFailure as failure:
+        summary["message"] = f"at t = 0 s: {failure}"
+    finally:
+        if recorder is not None:
+            recorder.close(simulation.impacts_per_vertex)
+            summary.update(quantities_of_run(out / "timeseries.h5"))
+        summary["wall_time_s"] = time.perf_counter() - clock
+        write_json(out / "summary.json", summary)
+    return summary
+
+
+def _dynamics_summary(model, simulation: Simulation, recorder: RunRecorder, state, u0: float) -> dict:
+    t = state.t
+    u = model.bit_state(state.q, state.qd)[0]
+    stats = simulation.stats
+    return {
+        "t_end": t,
+        "steps": stats["steps"],
+        "rejected_steps": stats["rejected_steps"],
+        "newton_failures": stats["newton_failures"],
+        "newton_iterations": stats["newton_iterations"],
+        "min_dt": stats["min_dt"], "max_dt": stats["max_dt"],
+        "mean_bit_velocity": (u - u0) / t if t > 0 else 0.0,
+        "impacts_total": int(simulation.impacts_per_vertex.sum()),
+        "section_x": recorder.section_x,
+        "energy": simulation.budget.summary(),
+    }
+
+
+def quantities_of_run(series_path: Path) -> dict:
+    """Drilling quantities (96)-(99), indicators and the von Mises maximum (100) of the saved series,
+    and ``advice`` on physics the scene paid for without needing it."""
+    data, attrs = read_series(series_path)
+    if len(data["time"]) < 2:
+        return {}
+    scene = attrs["scene"]
+    out = drilling_quantities(data, scene.drive.axial_velocity, scene.drive.rotation_speed)
+    stress = data["max_von_mises"]
+    if np.isfinite(stress).any():
+        k = int(np.nanargmax(stress))
+        out["max_von_mises"] = {"value": float(stress[k]), "x": float(data["max_von_mises_x"][k]),
+                                "t": float(data["time"][k])}
+    advice = []
+    if scene.model.contact and not data["vertices_in_contact"].any():
+        advice.append("the string never touched the wall: model.contact = false gives the same answer "
+                      "without paying for contact")
+    if advice:
+        out["advice"] = advice
+    return out

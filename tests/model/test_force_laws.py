@@ -1,0 +1,38 @@
+"""The pointwise force laws (16)-(22) in their physically consistent form (docs/errata.md)."""
+
+import numpy as np
+import pytest
+
+from fenics_drill.model.forces import bit_rock, wall_contact
+
+VELOCITIES = np.concatenate([-np.logspace(-6, 1, 50), [0.0], np.logspace(-6, 1, 50)])
+
+
+def test_wall_friction_never_does_positive_work():
+    """Over a sweep of u_dot, theta_x_dot of both signs and contact states, F_a u_dot <= 0 and T theta_x_dot <= 0."""
+    delta = np.array([-1e-3, 0.0, 1e-6, 1e-4, 2e-3])[:, None]
+    delta_rate = np.array([-0.5, 0.0, 0.5])[:, None, None]
+    normal = wall_contact.hunt_crossley_normal_force(delta, delta_rate, 1e10, 1e16, 1e6)
+    assert np.all(normal <= 0)
+    for vel in VELOCITIES:
+        force, torque = wall_contact.wall_friction(normal, vel, vel * 50, 0.25, 0.095, 1e-4)
+        assert np.all(force * vel <= 0) and np.all(torque * vel * 50 <= 0)
+
+
+def test_bit_rock_force_and_torque_never_do_positive_work():
+    for u_dot in VELOCITIES:
+        force = bit_rock.bit_rock_force(u_dot, 30e3, 400.0)
+        assert force * u_dot <= 0
+        for omega in VELOCITIES * 10:
+            torque = bit_rock.bit_rock_torque(force, omega, 0.4, 0.095)
+            assert torque * omega <= 0
+
+
+def test_hunt_crossley_damper_dissipates_and_has_force_units():
+    """With c |delta|^3 delta_dot, c in N s / m^4 gives newtons; the damper opposes delta_dot."""
+    c, delta, rate = 1e6, 1e-3, 0.1  # springs off to isolate the damper
+    approaching = wall_contact.hunt_crossley_normal_force(delta, rate, 0.0, 0.0, c)
+    assert approaching == pytest.approx(-c * delta**3 * rate, rel=1e-14)
+    assert approaching * rate < 0
+    # receding, the bare damper would pull towards the wall: the law clips it to zero
+    assert wall_contact.hunt_crossley_normal_force(delta, -rate, 0.0, 0.0, c) == 0.0

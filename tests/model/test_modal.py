@@ -1,0 +1,173 @@
+"""Modal analysis (62) against closed forms, the paper's quoted frequencies and Table 4."""
+
+import math
+
+import numpy as np
+import pytest
+from conftest import scene_with
+
+from fenics_drill.model.discretization import BeamDiscretization
+from fenics_drill.model.modes import solve_modes
+from fenics_drill.model.operators import assemble_linear
+from fenics_drill.studies.modal_report import modal_report
+
+# Roots of tan(x) = tanh(x): clamped-pinned Euler-Bernoulli beam (Blevins, Table 8-1).
+CLAMPED_PINNED_ROOTS = (3.926602312, 7.068582745, 10.21017612, 13.35176878, 16.49336143)
+
+
+def family_frequencies(basis, kind):
+    return basis.frequencies_hz[np.array(basis.kinds) == kind]
+
+
+def timoshenko_pinned_omega2(p, n):
+    """Lower root of the simply supported Timoshenko frequency equation for mode n.
+
+    With v = V sin(kx), theta = T cos(kx), k = n pi / L:
+    (kGA k^2 - rho A w^2)(E I k^2 + kGA - rho I w^2) - (kGA k)^2 = 0.
+    """
+    s = p.section
+    EI, kGA = p.young_modulus * s.I4, p.shear_factor * p.shear_modulus * s.area
+    rA, rI = p.density * s.area, p.density * s.I4
+    k = n * math.pi / p.length
+    a = rA * rI
+    b = -(rA * (EI * k**2 + kGA) + rI * kGA * k**2)
+    c = kGA * k**2 * EI * k**2
+    return (-b - math.sqrt(b * b - 4 * a * c)) / (2 * a)
+
+
+@pytest.fixture(scope="module")
+def slender_modes():
+    """100 m paper beam on 300 elements, modes up to f* = 2.2."""
+    scene = scene_with("beam.elements=300")
+    disc = BeamDiscretization.from_scene(scene)
+    return disc.properties, solve_modes(disc, 2.2)
+
+
+def test_total_mass_and_rotary_inertia_of_mass_matrix(paper_properties):
+    """1^T M_uu 1 = rho A L and 1^T M_txtx 1 = 2 rho I4 L (Eq. 44), to round-off."""
+    disc = BeamDiscretization(paper_properties, 37, 3)
+    M = assemble_linear(disc).mass
+    p = paper_properties
+    ones = {i: (disc.field_of_dof == i).astype(float) for i in range(6)}
+    for field, expected in ((0, p.density * p.section.area), (2, p.density * p.section.area),
+                            (3, 2 * p.density * p.section.I4), (5, p.density * p.section.I4)):
+        assert ones[field] @ M @ ones[field] == pytest.approx(expected * p.length, rel=1e-12)
+
+
+def test_axial_free_free_frequencies(slender_modes):
+    """u is free at both ends: f_n = n c_L / (2L).
+
+    P1 with consistent mass overestimates by (n pi h / L)^2 / 24 < 8e-5 for n <= 4,
+    h = L/300; tolerance 1e-3. The discrete spectrum itself is known exactly:
+    omega_h^2 = 6 c^2 (1 - cos kh) / (h^2 (2 + cos kh)), k = n pi / L, to round-off.
+    """
+    p, basis = slender_modes
+    f = family_frequencies(basis, "axial")
+    n = np.arange(1, len(f) + 1)
+    assert len(f) == 4  # f* = n/2 <= 2.2
+    c, h = p.longitudinal_wave_speed, p.length / 300
+    np.testing.assert_allclose(f, n * c / (2 * p.length), rtol=1e-3)
+    kh = n * math.pi / p.length * h
+    discrete = np.sqrt(6 * c**2 * (1 - np.cos(kh)) / (h**2 * (2 + np.cos(kh)))) / (2 * math.pi)
+    np.testing.assert_allclose(f, discrete, rtol=1e-8)
+
+
+def test_torsional_free_free_frequencies(slender_modes):
+    """Torsional stiffness 2 kappa_s G I4 over inertia 2 rho I4 (Eqs. 44, 46): f_n = n c_T / (2L)."""
+    p, basis = slender_modes
+    f = family_frequencies(basis, "torsional")
+    n = np.arange(1, len(f) + 1)
+    c_T = math.sqrt(p.shear_factor * p.shear_modulus / p.density)
+    assert len(f) == int(2 * 2.2 * p.longitudinal_wave_speed / c_T)  # f* = n c_T/(2 c_L) <= 2.2
+    np.testing.assert_allclose(f, n * c_T / (2 * p.length), rtol=1e-3)
+
+
+def test_two_rigid_body_modes(slender_modes):
+    _, basis = slender_modes
+    kinds = np.array(basis.kinds)
+    assert (kinds == "rigid").sum() == 2
+    rigid = np.flatnonzero(kinds == "rigid")
+    fractions = basis.energy_fractions[rigid]
+    # one pure axial translation, one pure rotation about x
+    assert sorted(np.argmax(fractions, axis=1)) == [0, 3]
+    assert np.all(fractions.max(axis=1) > 1 - 1e-9)
+
+
+def test_clamped_pinned_flexural_frequencies_match_euler_bernoulli(slender_modes):
+    """Paper supports give clamped-pinned bending in both planes, each root twice.
+
+    For L/r_g ~ 2100 the Timoshenko correction of the first 5 modes is < 2e-4 and the
+    P2/P1 mesh error on 300 elements ~ (beta h)^2 / 24 < 2e-4; tolerance 1e-3.
+    """
+    p, basis = slender_modes
+    f = family_frequencies(basis, "flexural")[:10]
+    s = p.section
+    a = math.sqrt(p.young_modulus * s.I4 / (p.density * s.area))
+    expected = np.repeat([(r / p.length) ** 2 * a / (2 * math.pi) for r in CLAMPED_PINNED_ROOTS], 2)
+    np.testing.assert_allclose(f, expected, rtol=1e-3)
+
+
+def test_pinned_pinned_stubby_beam_matches_timoshenko_not_euler_bernoulli():
+    """L = 2 m (L/r_g ~ 42): shear and rotary inertia lower the frequencies by several %;
+    the FE result must follow Timoshenko to 2e-4 (mesh error of 256 P2/P1 elements < 1e-4)."""
+    scene = scene_with("beam.length=2", "beam.elements=256", "model.supports=pinned")
+    disc = BeamDiscretization.from_scene(scene)
+    p = disc.properties
+    basis = solve_modes(disc, 0.6)
+    f = family_frequencies(basis, "flexural")[:8]
+    timoshenko = np.repeat([math.sqrt(timoshenko_pinned_omega2(p, n)) / (2 * math.pi) for n in (1, 2, 3, 4)], 2)
+    np.testing.assert_allclose(f, timoshenko, rtol=2e-4)
+    s = p.section
+    euler_bernoulli = (4 * math.pi / p.length) ** 2 * math.sqrt(p.young_modulus * s.I4 / (p.density * s.area)) / (
+        2 * math.pi
+    )
+    assert f[-1] < euler_bernoulli * (1 - 0.02)  # the test tells the two theories apart
+
+
+@pytest.mark.parametrize("degree, rate", [(2, 2.0), (3, 4.0)])
+def test_eigenvalue_convergence_rate(degree, rate):
+    """Eigenvalue error O(h^(2p)) with p = k - 1, the degree of the rotations (and of u).
+
+    Third flexural eigenvalue of a pinned 4 m beam against the Timoshenko closed form,
+    meshes of 4, 8, 16, 32 elements; observed rate within 0.15 of the theory.
+    """
+    errors = []
+    for n_el in (4, 8, 16, 32):
+        scene = scene_with("beam.length=4", f"beam.elements={n_el}", f"beam.element_degree={degree}",
+                           "model.supports=pinned")
+        disc = BeamDiscretization.from_scene(scene)
+        basis = solve_modes(disc, 0.6)
+        omega2 = (2 * math.pi * family_frequencies(basis, "flexural")[2]) ** 2
+        exact = timoshenko_pinned_omega2(disc.properties, 2)
+        errors.append(abs(omega2 - exact) / exact)
+    rates = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert rates[-1] == pytest.approx(rate, abs=0.15)
+
+
+@pytest.fixture(scope="module")
+def paper_report():
+    return modal_report(scene_with("beam.elements=500"))  # the paper's mesh (Section 6)
+
+
+def test_paper_flexural_frequencies_of_section_6_8(paper_report):
+    """Each flexural frequency quoted in Section 6.8 has a computed flexural mode within 1 %."""
+    flexural = np.array([m["frequency_hz"] for m in paper_report["modes"] if m["kind"] == "flexural"])
+    for quoted in (6.59, 7.63, 57.77, 83.65, 106.18, 114.27, 144.94, 174.07):
+        nearest = flexural[np.argmin(abs(flexural - quoted))]
+        assert nearest == pytest.approx(quoted, rel=0.01), quoted
+
+
+def test_paper_rule_counts_match_closed_form_counts(paper_report):
+    """The printed Section 6.3 rule on L = 100 m, counted independently from the closed forms:
+    flexural clamped-pinned roots with f <= 5 Hz (x2 planes), torsional n c_T/(2 c_L) <= 4,
+    axial n/2 <= 4 except n = 8, whose FE frequency lies just above f* = 4 (P1 stiffening)."""
+    p = scene_with().beam_properties
+    s = p.section
+    a = math.sqrt(p.young_modulus * s.I4 / (p.density * s.area))
+    roots = [(n + 0.25) * math.pi for n in range(1, 40)]  # asymptotic roots, exact to 1e-6 beyond n=3
+    flexural = 2 * sum((r / p.length) ** 2 * a / (2 * math.pi) <= 5.0 for r in roots)
+    torsional = int(8 * p.longitudinal_wave_speed / p.torsional_wave_speed)
+    red = paper_report["reduced_basis"]
+    assert red["counts"] == {"rigid": 2, "flexural": flexural, "torsional": torsional, "axial": 7}
+    assert red["size"] == 2 + flexural + torsional + 7
+    assert paper_report["full_dofs"] == 2 * (2 * 500 + 1) + 4 * 501

@@ -1,0 +1,151 @@
+"""Observables of a run (issue 5): von Mises stress against closed forms, drilling
+quantities of synthetic time series with known answers, spectra of sums of sinusoids."""
+
+import numpy as np
+import pytest
+from conftest import scene_with
+
+from fenics_drill.model.discretization import BeamDiscretization
+from fenics_drill.observables import drilling_quantities as dq
+from fenics_drill.observables.spectra import event_rate, power_spectral_density, resample, spectral_peaks, to_db, uniform_grid
+from fenics_drill.observables.von_mises import VonMisesProbe
+
+
+@pytest.fixture(scope="module")
+def disc():
+    return BeamDiscretization.from_scene(scene_with("beam.length=10", "beam.elements=8"))
+
+
+def state(disc, **fields):
+    """Dofs of the fields given as functions of x (u, v, w, tx, ty, tz)."""
+    names = ("u", "v", "w", "tx", "ty", "tz")
+    x = disc.dof_coordinates
+    dofs = np.zeros(disc.ndofs)
+    for i, name in enumerate(names):
+        if name in fields:
+            dofs[disc.field_dofs[i]] = fields[name](x)[disc.field_dofs[i]]
+    return dofs
+
+
+def test_von_mises_of_uniform_axial_strain_is_e_times_green_lagrange_strain(disc):
+    e = 2e-4
+    p = disc.properties
+    for nonlinear, strain in ((True, e + 0.5 * e**2), (False, e)):
+        probe = VonMisesProbe(disc, geometric_nonlinearity=nonlinear)
+        stress = probe.stress(state(disc, u=lambda x: e * x))
+        np.testing.assert_allclose(stress, p.young_modulus * strain, rtol=1e-12)
+
+
+def test_von_mises_of_pure_torsion_is_sqrt3_g_r_twist(disc):
+    """theta_x = phi x: tau = G R phi on the outer fibre, plus the Green-Lagrange axial
+    strain (R phi)^2 / 2 of the twisted fibre (Eqs. 34-36)."""
+    phi = 1e-3
+    p = disc.properties
+    R = p.outer_radius
+    probe = VonMisesProbe(disc)
+    stress = probe.stress(state(disc, tx=lambda x: phi * x))
+    exact = np.sqrt((p.young_modulus * 0.5 * (R * phi) ** 2) ** 2 + 3.0 * (p.shear_modulus * R * phi) ** 2)
+    np.testing.assert_allclose(stress, exact, rtol=1e-12)
+
+
+def test_von_mises_of_pure_bending_is_e_kappa_r_plus_the_green_lagrange_stretch(disc):
+    """v = kappa x^2 / 2, theta_z = v' (no shear).  Linear strains: sigma = E kappa R on the outer
+    fibre (y = -R is a sample point).  Green-Lagrange (34): the fibre also stretches by
+    (kappa R)^2 / 2 + v'^2 / 2, largest at x = L; the shear it adds is ~1e-5 of sigma."""
+    kappa = 1e-5
+    p = disc.properties
+    R, L, E = p.outer_radius, p.length, p.young_modulus
+    bent = state(disc, v=lambda x: 0.5 * kappa * x**2, tz=lambda x: kappa * x)
+    value, _ = VonMisesProbe(disc, geometric_nonlinearity=False).maximum(bent)
+    assert value == pytest.approx(E * kappa * R, rel=1e-12)
+    value, where = VonMisesProbe(disc).maximum(bent)
+    assert value == pytest.approx(E * (kappa * R + 0.5 * kappa**2 * (R**2 + L**2)), rel=1e-4)
+    assert where == pytest.approx(L)
+
+
+#: A threshold crossing is located to one sample: two crossings per period of 1000 samples.
+CROSSING = 2.0 / 1000
+
+
+def synthetic_run(v0=0.005, omega=6.0, velocity_amplitude=0.002, omega_amplitude=0.0, periods=20, f=3.0):
+    """Time series of a run with known answers: whole periods of sinusoids about the drive speeds."""
+    t = np.linspace(0.0, periods / f, 20001)
+    phase = 2 * np.pi * f * t
+    return t, {
+        "time": t, "lambda_1": np.full_like(t, -4e4), "lambda_4": np.full_like(t, -9e3),
+        "bit_velocity": v0 + velocity_amplitude * np.sin(phase), "bit_force": np.full_like(t, -3e4),
+        "bit_angular_velocity": omega * (1 + omega_amplitude * np.sin(phase)), "bit_torque": np.full_like(t, -2e3),
+        "impacts": np.zeros_like(t),
+    }
+
+
+def test_efficiency_is_output_over_input_work_of_eqs_96_to_98():
+    v0, omega = 0.005, 6.0
+    t, series = synthetic_run(v0, omega)
+    q = dq.drilling_quantities(series, v0, omega)
+    # u_dot_bit > 0 throughout and the sinusoid integrates to zero over whole periods
+    assert q["efficiency"] == pytest.approx((v0 * 3e4 + omega * 2e3) / (v0 * 4e4 + omega * 9e3), rel=1e-7)
+    assert q["mean_input_power"] == pytest.approx(v0 * 4e4 + omega * 9e3, rel=1e-12)
+
+
+def test_rop_takes_the_positive_part_and_the_signed_variant_does_not():
+    """u_dot = V0 + a sin: mean of the positive part a [c (pi + 2 asin c) + 2 sqrt(1 - c^2)] / (2 pi), c = V0/a."""
+    v0, a = 0.002, 0.005
+    t, series = synthetic_run(v0, velocity_amplitude=a)
+    c = v0 / a
+    exact = a * (c * (np.pi + 2 * np.arcsin(c)) + 2 * np.sqrt(1 - c**2)) / (2 * np.pi)
+    q = dq.drilling_quantities(series, v0, 6.0)
+    assert q["rop"] == pytest.approx(exact, rel=1e-6)
+    assert q["signed_rop"] == pytest.approx(v0, rel=1e-7)
+    # the bit moves backwards while sin < -c
+    assert q["bit_bounce"]["off_bottom_fraction"] == pytest.approx((np.pi - 2 * np.arcsin(c)) / (2 * np.pi), abs=CROSSING)
+    assert q["bit_bounce"]["velocity_min_ratio"] == pytest.approx(1 - a / v0, rel=1e-6)
+
+
+def test_stick_slip_indicators_of_a_sinusoidal_bit_speed():
+    """omega = Omega (1 + 1.5 sin): stuck (< 0.1 Omega) while sin < -0.6; severity (2.5 + 0.5) / 2."""
+    t, series = synthetic_run(omega=6.0, omega_amplitude=1.5)
+    s = dq.drilling_quantities(series, 0.005, 6.0)["stick_slip"]
+    assert s["stick_fraction"] == pytest.approx((np.pi - 2 * np.arcsin(0.6)) / (2 * np.pi), abs=CROSSING)
+    assert s["stick_slip_severity"] == pytest.approx(1.5, rel=1e-6)
+    assert s["omega_max_ratio"] == pytest.approx(2.5, rel=1e-6)
+
+
+def test_psd_of_two_sinusoids_peaks_at_their_frequencies_with_their_power():
+    """Periodogram of A1 sin(2 pi f1 t) + A2 sin(2 pi f2 t) over whole periods: each line holds
+    exactly A^2 / 2 (Parseval).  Non-uniform steps, resampled first, keep the peaks in place."""
+    step = 1e-3
+    (f1, a1), (f2, a2) = (57.0, 2.0), (143.0, 0.5)
+    wave = lambda t: a1 * np.sin(2 * np.pi * f1 * t) + a2 * np.sin(2 * np.pi * f2 * t)  # noqa: E731
+    t = step * np.arange(4000)  # 4 s: whole periods of both
+    freq, psd = power_spectral_density(wave(t), step)
+    df = freq[1] - freq[0]
+    for f, a in ((f1, a1), (f2, a2)):
+        line = np.abs(freq - f) < 0.5 * df
+        assert np.sum(psd[line]) * df == pytest.approx(a**2 / 2, rel=1e-9)
+    assert np.sum(psd) * df == pytest.approx((a1**2 + a2**2) / 2, rel=1e-9)
+    rng = np.random.default_rng(3)
+    t = np.cumsum(np.r_[0.0, step * rng.uniform(0.5, 1.5, 3999)])  # like an adaptive run
+    grid = uniform_grid(t, step)
+    freq, psd = power_spectral_density(resample(t, wave(t), grid), step)
+    peaks = spectral_peaks(freq, to_db(psd), count=2)
+    assert [p["frequency_hz"] for p in peaks] == pytest.approx([f1, f2], abs=freq[1] - freq[0])
+
+
+def test_event_rate_keeps_every_event():
+    t = np.array([0.0, 0.0101, 0.0102, 0.5, 0.9999])
+    counts = np.array([0, 2, 1, 3, 1])
+    grid = uniform_grid(np.array([0.0, 1.0]), 0.01)
+    rate = event_rate(t, counts, grid)
+    assert np.sum(rate) * 0.01 == pytest.approx(counts.sum())
+    assert rate[1] == pytest.approx(300.0)  # three events in the cell around t = 0.01
+
+
+def test_shock_packages_are_groups_of_impacts_separated_by_quiet_time():
+    t = np.linspace(0.0, 3.0, 3001)
+    impacts = np.zeros_like(t)
+    for start in (0.1, 1.1, 2.1):  # three bursts of 50 ms, one impact every 5 ms
+        impacts[(t >= start) & (t < start + 0.05) & (np.round(t * 1000) % 5 == 0)] = 1
+    assert dq.shock_packages(t, impacts) == 3
+    assert dq.shock_packages(t, impacts, quiet_gap=1.5) == 1
+    assert dq.shock_packages(t, np.zeros_like(t)) == 0
