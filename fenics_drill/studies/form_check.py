@@ -24,7 +24,7 @@ import numpy as np
 import ufl
 from dolfinx import fem
 
-from fenics_drill.model.discretization import BeamDiscretization
+from fenics_drill.model.discretization import THETA_X, BeamDiscretization
 from fenics_drill.forms import FIELD_NAMES, mass_form
 from fenics_drill.forms.energies import inertial_force, strain_energy_gradient_terms, strain_slots
 from fenics_drill.forms.printed import (
@@ -59,7 +59,7 @@ def random_state(disc: BeamDiscretization, seed: int, scale: float = 0.05, rotat
     rng = np.random.default_rng(seed)
     f = fem.Function(disc.V)
     f.x.array[:] = scale * rng.standard_normal(disc.ndofs)
-    tx = disc.field_dofs[3]
+    tx = disc.field_dofs[THETA_X]
     f.x.array[tx] = rotation_scale * rng.standard_normal(len(tx))
     return f
 

@@ -9,6 +9,7 @@ import ufl
 from conftest import scene_with
 from dolfinx import fem
 
+from fenics_drill.model import discretization as field
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.studies.form_check import compare_printed_forms, random_state
 from fenics_drill.forms import damping_form, mass_form, stiffness_form
@@ -95,8 +96,8 @@ def test_rigid_motions_produce_no_elastic_force(disc):
     K_scale = np.abs(vector(elastic_force(p, psi, random_state(disc, 1), dx))).max()
     for tx, u in ((1.3, 0.0), (0.0, 0.7), (-2.9, 0.2)):
         U.x.array[:] = 0.0
-        U.x.array[disc.field_dofs[3]] = tx
-        U.x.array[disc.field_dofs[0]] = u
+        U.x.array[disc.field_dofs[field.THETA_X]] = tx
+        U.x.array[disc.field_dofs[field.U]] = u
         assert np.abs(vector(elastic_force(p, psi, U, dx))).max() <= 1e-12 * K_scale
 
 
@@ -166,12 +167,12 @@ def test_a_rigid_spin_leaves_the_strain_energy_of_a_bent_string_unchanged_only_w
     x = disc.dof_coordinates
     L = p.length
     w = 1e-3 * np.sin(np.pi * x / L)  # a sag shape in z with its Euler-Bernoulli rotation
-    bent.x.array[disc.field_dofs[2]] = w[disc.field_dofs[2]]
-    bent.x.array[disc.field_dofs[4]] = -(1e-3 * np.pi / L * np.cos(np.pi * x / L))[disc.field_dofs[4]]
+    bent.x.array[disc.field_dofs[field.W]] = w[disc.field_dofs[field.W]]
+    bent.x.array[disc.field_dofs[field.THETA_Y]] = -(1e-3 * np.pi / L * np.cos(np.pi * x / L))[disc.field_dofs[field.THETA_Y]]
     energies = []
     for phi in (0.0, 0.7, np.pi / 2):
         spun = bent.copy()
-        spun.x.array[disc.field_dofs[3]] += phi
+        spun.x.array[disc.field_dofs[field.THETA_X]] += phi
         energies.append(fem.assemble_scalar(fem.form(
             strain_energy_density(p, strain_slots(spun), kinematics=kinematics) * dx)))
     spread = (max(energies) - min(energies)) / energies[0]
