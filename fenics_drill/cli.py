@@ -1,15 +1,24 @@
-"""Command-line interface: ``fenics-drill <command> SCENE [--set section.key=value ...] --out DIR``."""
+"""Command-line interface: ``fenics-drill <command> SCENE [--set section.key=value ...] --out DIR``.
+
+Every ordinary error (a bad scene, an unusable output directory, a scene too large for the
+machine, an unreadable file) ends the command with a one-line message naming the key, the path
+or the file, and exit code 2; Ctrl-C or SIGTERM with 130.  Under ``mpiexec`` an error on one rank
+ends the whole job (``MPI_Abort``) with that rank's message.  ``run``, ``static`` and ``modal``
+run in a worker process (:mod:`fenics_drill.supervisor`) so that a signal stops them within
+seconds even inside a long C call.
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
-import signal
 import sys
-import time
 from pathlib import Path
 
 from fenics_drill.scene import SceneError, load_scene, section_keys
+
+#: Commands run in a supervised worker process (single-process commands that can run long).
+SUPERVISED = ("run", "static", "modal")
 
 
 def _scene_args(parser: argparse.ArgumentParser, out: bool = True) -> None:
@@ -19,7 +28,10 @@ def _scene_args(parser: argparse.ArgumentParser, out: bool = True) -> None:
         help="override one scene key; the value is read as TOML (repeatable)",
     )
     if out:
-        parser.add_argument("--out", default="out", help="output directory (created if missing)")
+        parser.add_argument("--out", default="out", help="output directory (created if missing; it must be new "
+                            "or empty, or hold this command's earlier output with --overwrite)")
+        parser.add_argument("--overwrite", action="store_true",
+                            help="replace this command's earlier output in --out (and nothing else there)")
 
 
 def cmd_scene(args) -> int:
@@ -36,20 +48,15 @@ def cmd_scene(args) -> int:
 
 def cmd_modal(args) -> int:
     """Modal analysis (62) and reduced-basis selection; writes DIR/modes.json."""
-    from fenics_drill.studies.modal_report import modal_report
+    from fenics_drill.studies.modal_report import write_modal_report
 
     scene = load_scene(args.scene, args.overrides)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    start = time.perf_counter()
-    report = modal_report(scene)
-    report["wall_time_s"] = time.perf_counter() - start
-    (out / "modes.json").write_text(json.dumps(report, indent=1))
+    report = write_modal_report(scene, args.out, overwrite=args.overwrite)
     red = report["reduced_basis"]
     print(
         f"{report['full_dofs']} dofs, {len(report['modes'])} modes with f* <= {scene.modal.f_star_max}, "
         f"reduced basis ({scene.reduction.rule}): {red['size']} = {red['counts']} "
-        f"[{report['wall_time_s']:.1f} s] -> {out / 'modes.json'}"
+        f"[{report['wall_time_s']:.1f} s] -> {Path(args.out) / 'modes.json'}"
     )
     return 0
 
@@ -59,7 +66,7 @@ def cmd_static(args) -> int:
     from fenics_drill.studies.run import run_static
 
     scene = load_scene(args.scene, args.overrides)
-    report = run_static(scene, args.out)
+    report = run_static(scene, args.out, overwrite=args.overwrite)
     print(
         f"max sag {report['max_sag'] * 1e3:.3f} mm at x = {report['max_sag_position']:.1f} m, "
         f"{len(report['contact_vertices'])} vertices on the wall -> {Path(args.out) / 'static.json'}"
@@ -67,18 +74,12 @@ def cmd_static(args) -> int:
     return 0
 
 
-def _terminate_as_interrupt(signum, frame):
-    """A batch system's SIGTERM (time limit, scancel) ends a run like Ctrl-C: summary.json is written."""
-    raise KeyboardInterrupt
-
-
 def cmd_run(args) -> int:
     """Drilling dynamics from the static equilibrium: summary.json, timeseries.h5, fields.xdmf."""
     from fenics_drill.studies.run import run_scene
 
     scene = load_scene(args.scene, args.overrides)
-    signal.signal(signal.SIGTERM, _terminate_as_interrupt)
-    summary = run_scene(scene, args.out, progress=not args.quiet)
+    summary = run_scene(scene, args.out, progress=not args.quiet, overwrite=args.overwrite)
     print(
         f"{summary['status']}: {summary['message']}; t = {summary['t_end']:.4g} s in {summary['steps']} steps, "
         f"wall {summary['wall_time_s']:.1f} s -> {Path(args.out) / 'summary.json'}"
@@ -88,25 +89,25 @@ def cmd_run(args) -> int:
             f"mean bit velocity {summary['mean_bit_velocity'] * 3600:.2f} m/h, rop {summary['rop'] * 3600:.2f} m/h, "
             f"impacts {summary['impacts_total']}, energy balance error {summary['energy']['balance_error']:.2e}"
         )
+    for reason in summary.get("suspect_reasons", []):
+        print(f"SUSPECT: {reason}")
     for advice in summary.get("advice", []):
         print(f"note: {advice}")
-    return {"finished": 0, "interrupted": 130}.get(summary["status"], 1)
+    return {"finished": 0, "suspect": 0, "interrupted": 130}.get(summary["status"], 1)
 
 
 def cmd_mc(args) -> int:
     """Monte Carlo over the random bit-rock laws; with mpiexec -n P, realisations spread over P ranks."""
+    from fenics_drill.scene import MAX_SAMPLES
     from fenics_drill.studies.monte_carlo import monte_carlo
-    from fenics_drill.studies.uncertainty import InadmissibleLaw
 
     scene = load_scene(args.scene, args.overrides)
-    if args.samples < 1:
-        print("fenics-drill: --samples must be >= 1", file=sys.stderr)
+    if not 1 <= args.samples <= MAX_SAMPLES:
+        print(f"fenics-drill: --samples {args.samples} is not admissible: must be in [1, {MAX_SAMPLES}]",
+              file=sys.stderr)
         return 2
-    try:
-        summary = monte_carlo(scene, args.samples, args.out, resume=args.resume, progress=not args.quiet)
-    except (InadmissibleLaw, ValueError) as err:
-        print(f"fenics-drill: {err}", file=sys.stderr)
-        return 2
+    summary = monte_carlo(scene, args.samples, args.out, resume=args.resume, progress=not args.quiet,
+                          overwrite=args.overwrite)
     if summary is not None:
         rop, eff = summary["rop"], summary["efficiency"]
         print(f"{summary['realisations']} realisations ({summary['failed']} failed), conv_MC "
@@ -119,14 +120,9 @@ def cmd_mc(args) -> int:
 def cmd_optimize(args) -> int:
     """The operating window: deterministic or robust optimum of rop or efficiency under the von Mises limit."""
     from fenics_drill.studies.operating_window import run_optimize
-    from fenics_drill.studies.uncertainty import InadmissibleLaw
 
     scene = load_scene(args.scene, args.overrides)
-    try:
-        report = run_optimize(scene, args.out, resume=args.resume, progress=not args.quiet)
-    except (InadmissibleLaw, ValueError) as err:
-        print(f"fenics-drill: {err}", file=sys.stderr)
-        return 2
+    report = run_optimize(scene, args.out, resume=args.resume, progress=not args.quiet, overwrite=args.overwrite)
     if report is not None:
         if report["feasible"]:
             o = report["optimum"]
@@ -140,14 +136,10 @@ def cmd_optimize(args) -> int:
 
 def cmd_plot(args) -> int:
     """Figures of a saved run (Figs. 13-23), Monte Carlo study (Figs. 28-35) or operating window (24-27, 36)."""
-    from fenics_drill.plots.directory import NothingToPlot, plot_directory
+    from fenics_drill.plots.directory import plot_directory
 
     directory = Path(args.run_dir)
-    try:
-        paths = plot_directory(directory, gif=not args.no_gif)
-    except NothingToPlot as err:
-        print(f"fenics-drill: {err}", file=sys.stderr)
-        return 2
+    paths = plot_directory(directory, gif=not args.no_gif)
     print(f"{len(paths)} files in {directory}: " + ", ".join(p.name for p in paths))
     return 0
 
@@ -227,13 +219,72 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+def _user_errors() -> tuple[type, ...]:
+    """The ordinary errors: each ends a command with its message (exit 2), never a traceback."""
+    from fenics_drill.io.files import UnreadableFile
+    from fenics_drill.io.output_directory import OutputError
+    from fenics_drill.model.resources import ResourceError
+    from fenics_drill.plots.directory import NothingToPlot
+    from fenics_drill.studies.uncertainty import InadmissibleLaw
+
+    return SceneError, OutputError, ResourceError, UnreadableFile, InadmissibleLaw, NothingToPlot
+
+
+def _collective_errors() -> tuple[type, ...]:
+    """Errors every MPI rank meets alike (scene checks, laws, the study directory's verdict broadcast by
+    rank 0): each rank can return its code.  Any other error on one rank ends the job with MPI_Abort."""
+    from fenics_drill.io.output_directory import OutputError
+    from fenics_drill.studies.uncertainty import InadmissibleLaw
+
+    return SceneError, OutputError, InadmissibleLaw
+
+
+def _execute(args) -> int:
+    """Run a command in this process; ordinary errors become messages, other errors under MPI end the job."""
+    from mpi4py import MPI
+
+    comm = MPI.COMM_WORLD
+    where = f" (rank {comm.rank} of {comm.size})" if comm.size > 1 else ""
     try:
         return args.func(args)
-    except SceneError as err:
-        print(f"fenics-drill: scene error: {err}", file=sys.stderr)
+    except _user_errors() as err:
+        kind = "scene error: " if isinstance(err, SceneError) else ""
+        print(f"fenics-drill{where}: {kind}{err}", file=sys.stderr)
+        if comm.size > 1 and not isinstance(err, _collective_errors()):
+            sys.stderr.flush()
+            comm.Abort(2)
         return 2
+    except KeyboardInterrupt:
+        print(f"fenics-drill{where}: interrupted", file=sys.stderr)
+        return 130
+    except Exception:
+        if comm.size == 1:
+            raise
+        import traceback
+
+        traceback.print_exc()
+        print(f"fenics-drill{where}: failed; ending every rank", file=sys.stderr)
+        sys.stderr.flush()
+        comm.Abort(1)
+        return 1
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The ``fenics-drill`` tool.  Called without ``argv`` (the console script), ``run``, ``static`` and
+    ``modal`` go to a supervised worker process; with ``argv`` (tests, scripts) everything runs here."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if argv is None and args.command in SUPERVISED:
+        from fenics_drill import supervisor
+
+        if not supervisor.is_worker():
+            try:
+                load_scene(args.scene, args.overrides)  # bad input is refused here, before any worker starts
+            except SceneError as err:
+                print(f"fenics-drill: scene error: {err}", file=sys.stderr)
+                return 2
+            return supervisor.supervise(sys.argv[1:], args.command, Path(args.out))
+    return _execute(args)
 
 
 if __name__ == "__main__":

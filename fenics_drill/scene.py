@@ -59,7 +59,7 @@ def _grid_axis(x) -> bool:
     if len(x) != 3 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in x):
         return False
     low, high, n = x
-    return 0 <= low <= high and float(n).is_integer() and n >= 1 and (n > 1 or low == high)
+    return 0 <= low <= high and float(n).is_integer() and 1 <= n <= 1000 and (n > 1 or low == high)
 
 
 def _band_or_count(doc: str):
@@ -192,7 +192,11 @@ class Uncertainty:
     output_interval: float = _pos("step of the common time grid of the Monte Carlo histories [s]", 0.01)
 
 
-_GRID = "[min, max, n] with 0 <= min <= max and n >= 1 whole"
+_GRID = "[min, max, n] with 0 <= min <= max and n a whole number in [1, 1000]"
+
+#: Most realisations a study takes (per grid point for ``optimize``): each is a run and a file, and
+#: the statistics (101) of 10^4 are converged far beyond what the bit-rock data support.
+MAX_SAMPLES = 10_000
 
 
 @dataclass(frozen=True)
@@ -207,7 +211,7 @@ class Optimize:
     ultimate_strength: float = _pos("UTS of the von Mises constraint (100), (103) [Pa]", 650e6)
     samples: int = key(0, "realisations per grid point: 0 = deterministic (nominal bit-rock), "
                        "N > 0 = robust, E[objective] (102) under the chance constraint (103)-(104)",
-                       _non_negative, ">= 0")
+                       lambda n: 0 <= n <= MAX_SAMPLES, f"in [0, {MAX_SAMPLES}]")
     risk: float = key(0.1, "P_risk of the chance constraint (104) [-]", lambda x: 0 < x < 1, "in (0, 1)")
 
 
@@ -310,6 +314,10 @@ def _check_relations(scene: Scene) -> Scene:
     if scene.output.section > beam.length:
         raise SceneError(f"output.section = {scene.output.section!r} is not admissible: "
                          f"must be in [0, beam.length = {beam.length!r}]")
+    if scene.model.contact and scene.contact.stiffness_linear == 0:
+        raise SceneError("contact.stiffness_linear = 0.0 is not admissible with model.contact = true: without "
+                         "its linear spring the wall lets the string through (k_FS2 delta^3 is negligible at small "
+                         "penetrations); give k_FS1 > 0, or set model.contact = false to leave the wall out")
     red = scene.reduction
     if red.rule in ("band", "count"):
         for family in ("flexural", "torsional", "axial"):
@@ -356,17 +364,31 @@ def parse_override(text: str) -> tuple[str, str, Any]:
     return parts[0], parts[1], value
 
 
+def _read_toml(path: Path) -> dict[str, Any]:
+    """The TOML document of a scene file, or a SceneError that names the file and says what is wrong."""
+    name = repr(str(path))
+    if path.is_dir():
+        raise SceneError(f"scene file {name} is a directory, not a TOML file")
+    if not path.exists():
+        raise SceneError(f"scene file {name} does not exist")
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except OSError as err:
+        raise SceneError(f"scene file {name} cannot be read: {err.strerror}") from err
+    except UnicodeDecodeError as err:
+        raise SceneError(f"scene file {name} is not UTF-8 text (a binary or UTF-16 file?); a scene is a TOML "
+                         f"file in UTF-8: {err.reason} at byte {err.start}") from err
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise SceneError(f"scene file {name} is not valid TOML: {err}") from err
+
+
 def load_scene(path: str | Path | None = None, overrides: list[str] | tuple[str, ...] = ()) -> Scene:
     """Read a scene file (or the defaults when ``path`` is None), apply overrides, validate."""
     raw: dict[str, Any] = {}
     if path is not None:
-        path = Path(path)
-        if not path.is_file():
-            raise SceneError(f"scene file {str(path)!r} does not exist")
-        try:
-            raw = tomllib.loads(path.read_text())
-        except tomllib.TOMLDecodeError as err:
-            raise SceneError(f"scene file {str(path)!r} is not valid TOML: {err}") from err
+        raw = _read_toml(Path(path))
     for text in overrides:
         section, name, value = parse_override(text)
         raw.setdefault(section, {})

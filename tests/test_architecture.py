@@ -18,6 +18,7 @@ LAYERS = {
     "fenics_drill.plots": 7,
     "fenics_drill.api": 8,
     "fenics_drill.cli": 9,
+    "fenics_drill.supervisor": 9,
 }
 
 

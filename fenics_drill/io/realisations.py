@@ -4,8 +4,8 @@ A realisation file holds, on the common grid of ``uncertainty.output_interval``,
 histories of :data:`fenics_drill.studies.prepare.HISTORIES`; and as attributes its
 bit-rock parameters, status, rop, efficiency, mean bit velocity, max von Mises stress
 and int ||q||^2 dt (for (101)).  Each is written through a temporary file renamed into
-place (:func:`fenics_drill.io.study_directory.write_atomic`), so a killed study leaves
-no half-written result.
+place (:func:`fenics_drill.io.files.write_atomic`), so a killed study leaves no
+half-written result; a file broken otherwise is named by :func:`read_realisation`.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import h5py
 
-from fenics_drill.io.study_directory import write_atomic
+from fenics_drill.io.files import UnreadableFile, write_atomic
 
 #: Scalars kept per realisation.
 SCALARS = ("rop", "efficiency", "signed_rop", "mean_bit_velocity", "max_von_mises", "q_norm_integral")
@@ -44,10 +44,17 @@ def write_realisation(path: Path, result: dict) -> None:
 
 
 def read_realisation(path: Path, histories: bool = True) -> dict:
-    """A realisation's attributes, and with ``histories`` its time grid and histories."""
-    with h5py.File(path, "r") as f:
-        out = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
-        if histories:
-            out["time"] = f["time"][()]
-            out["histories"] = {name: f[name][()] for name in f if name != "time"}
+    """A realisation's attributes, and with ``histories`` its time grid and histories; UnreadableFile
+    naming the file if it is not a whole realisation."""
+    try:
+        with h5py.File(path, "r") as f:
+            out = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+            if histories:
+                out["time"] = f["time"][()]
+                out["histories"] = {name: f[name][()] for name in f if name != "time"}
+            missing = {"status", "q_norm_integral"} - set(out)
+    except (OSError, KeyError) as err:
+        raise UnreadableFile(f"{path} is not a readable realisation file (truncated or corrupt?): {err}") from err
+    if missing:
+        raise UnreadableFile(f"{path} is not a whole realisation file: {', '.join(sorted(missing))} missing")
     return out

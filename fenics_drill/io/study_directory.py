@@ -1,42 +1,42 @@
 """The output directory of a study spread over MPI ranks (``fenics-drill mc`` and ``optimize``).
 
-One result file per task, each written through a temporary file renamed into place, so a
-killed study leaves only whole results; a ``scene.json`` beside them says which scene they
-belong to, so that ``--resume`` continues that study and nothing else.
+Rank 0 takes the directory under the common policy (:mod:`fenics_drill.io.output_directory`)
+and checks, on ``--resume``, that ``scene.json`` is the scene being run, so that a study
+continues itself and nothing else; every rank then sees the same verdict, so a refusal ends
+all of them alike.  One result file per task, each written whole (:mod:`fenics_drill.io.files`),
+so a killed study leaves only whole results.
 """
 
 from __future__ import annotations
 
 import json
-import os
 import sys
 from pathlib import Path
 
+from fenics_drill.io.files import UnreadableFile, read_json, write_json
+from fenics_drill.io.output_directory import OutputClaim, OutputError, claim_output
 
-def claim(out: Path, scene: dict, results: str, pattern: str, resume: bool, comm) -> None:
-    """On rank 0: create ``out/results``, refuse another scene's study or an existing one without
-    ``resume``, record the scene.  Every rank raises ValueError with the same message on refusal."""
-    error = None
+
+def claim(out: Path, scene: dict, command: str, resume: bool, overwrite: bool, comm) -> OutputClaim:
+    """On rank 0: take ``out`` for ``command``, refuse another scene's study, record the scene.  Every rank
+    raises the same OutputError on refusal; each returns its claim (rank 0's holds the directory's lock,
+    the others' nothing), to hold to the end of the study."""
+    error, held = None, OutputClaim(out, command, None)
     if comm.rank == 0:
-        (out / results).mkdir(parents=True, exist_ok=True)
-        meta = out / "scene.json"
-        done = len(list((out / results).glob(pattern)))
-        if meta.exists() and json.loads(meta.read_text()) != json.loads(json.dumps(scene)):
-            error = f"{out} holds a study of another scene; choose another --out"
-        elif done and not resume:
-            error = f"{out} already holds {done} results: add --resume to continue that study, or choose another --out"
-        else:
-            meta.write_text(json.dumps(scene, indent=1))
+        try:
+            held = claim_output(out, command, overwrite=overwrite, resume=resume)
+            meta = out / "scene.json"
+            if meta.exists() and read_json(meta) != json.loads(json.dumps(scene)):
+                held.release()
+                error = f"--out {out} holds a study of another scene; choose another --out"
+            else:
+                write_json(meta, scene)
+        except (OutputError, UnreadableFile) as err:
+            error = str(err)
     error = comm.bcast(error, root=0)
     if error:
-        raise ValueError(error)
-
-
-def write_atomic(path: Path, write) -> None:
-    """``write(tmp)`` a temporary file beside ``path``, then rename it into place."""
-    tmp = path.with_suffix(f".tmp{os.getpid()}")
-    write(tmp)
-    os.replace(tmp, path)
+        raise OutputError(error)
+    return held
 
 
 def all_done(comm, progress: bool) -> bool:

@@ -18,6 +18,7 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from fenics_drill.forms import FIELD_NAMES, BeamProperties
+from fenics_drill.model.resources import check_memory
 
 #: Index of each field in the mixed space, in the paper's order (the one place they are declared).
 U, V, W, THETA_X, THETA_Y, THETA_Z = range(6)
@@ -54,7 +55,9 @@ class BeamDiscretization:
 
     @classmethod
     def from_scene(cls, scene) -> "BeamDiscretization":
-        """The discretization a scene asks for (``beam.*``, ``model.supports``)."""
+        """The discretization a scene asks for (``beam.*``, ``model.supports``); refused before any
+        allocation if it does not fit in memory (:mod:`fenics_drill.model.resources`)."""
+        check_memory(scene.beam.elements, scene.beam.element_degree)
         return cls(scene.beam_properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports)
 
     @property

@@ -5,6 +5,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from fenics_drill.io.files import UnreadableFile, read_json
+from fenics_drill.io.timeseries import read_series
+
 
 class NothingToPlot(ValueError):
     """The directory holds none of the files the figures are drawn from."""
@@ -23,6 +26,19 @@ def plot_directory(directory: Path, gif: bool = True) -> list[Path]:
     if (directory / "timeseries.h5").exists():
         from fenics_drill.plots.run_figures import plot_run
 
+        _check_run(directory)
         return plot_run(directory, gif=gif)
     raise NothingToPlot(f"{directory} holds no timeseries.h5 ('fenics-drill run'), statistics.h5 "
                         "('fenics-drill mc') or optimize.json ('fenics-drill optimize')")
+
+
+def _check_run(directory: Path) -> None:
+    """Refuse a run directory whose run recorded nothing to draw (it failed or was stopped at t = 0)."""
+    data, _ = read_series(directory / "timeseries.h5")  # UnreadableFile names a broken file
+    if len(data["time"]) < 2:
+        try:
+            summary = read_json(directory / "summary.json")
+            said = f" ({summary.get('status')}: {summary.get('message')})"
+        except (UnreadableFile, OSError):
+            said = ""
+        raise NothingToPlot(f"{directory}: the run{said} recorded fewer than two instants; there is nothing to draw")

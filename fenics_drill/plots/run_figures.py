@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fenics_drill.io.json_files import write_json
+from fenics_drill.io.files import write_json
 from fenics_drill.io.timeseries import read_modes, read_series
 from fenics_drill.observables.spectra import run_spectra
 from fenics_drill.plots.common import M_PER_S_TO_M_PER_H, RAD_PER_S_TO_RPM, panels, save_figure

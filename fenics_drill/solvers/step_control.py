@@ -39,6 +39,8 @@ class StepController:
         self.error_factor = abs(beta - 1.0 / 6.0)
         self.lateral_rows = lateral_rows
         self.dt = self.nominal
+        self.forced_steps = 0  # steps accepted at the minimum size although their error exceeded the tolerance
+        self.worst_forced_ratio = 0.0
 
     def error_ratio(self, dt: float, qdd_old: np.ndarray, qdd_new: np.ndarray) -> float:
         """Estimated local error over the tolerance (<= 1: accept)."""
@@ -46,12 +48,17 @@ class StepController:
         return max(float(np.max(np.abs(rows @ e))) for rows in self.lateral_rows) / self.tolerance
 
     def judge(self, dt: float, ratio: float) -> bool:
-        """Accept or reject a converged step and set the next proposal."""
+        """Accept or reject a converged step and set the next proposal.  A step already at the minimum
+        size is accepted whatever its error, and counted in :attr:`forced_steps` (a run with such steps
+        is reported "suspect")."""
         if not self.adaptive:
             self.dt = self.nominal
             return True
         factor = self.SAFETY * max(ratio, 1e-12) ** (-1.0 / 3.0)
         accept = ratio <= 1.0 or dt <= self.minimum * (1 + 1e-9)
+        if accept and ratio > 1.0:  # nothing smaller is allowed: taken, and counted against the run
+            self.forced_steps += 1
+            self.worst_forced_ratio = max(self.worst_forced_ratio, ratio)
         factor = min(self.GROWTH_MAX, max(self.SHRINK_MIN, factor))
         self.dt = min(self.nominal, max(self.minimum, dt * factor))
         return accept

@@ -44,7 +44,7 @@ class Simulation:
         n_vertices = len(model.disc.vertex_x)
         self.impacts_per_vertex = np.zeros(n_vertices, dtype=np.int64)
         self.stats = {"steps": 0, "rejected_steps": 0, "newton_failures": 0, "newton_iterations": 0,
-                      "min_dt": np.inf, "max_dt": 0.0}
+                      "min_dt": np.inf, "max_dt": 0.0, "forced_steps": 0, "max_penetration": 0.0}
         self.last_state: State | None = None  # the latest accepted state (what an interrupted run keeps)
 
     def initial_state(self, q0: np.ndarray, mu0: np.ndarray) -> State:
@@ -67,6 +67,12 @@ class Simulation:
         kinetic = self.model.internal.kinetic_energy(state.q, state.qd)
         strain = self.model.internal.strain_energy(state.q)
         return kinetic, strain, self.model.potential_energy(ev)
+
+    @staticmethod
+    def _penetration(ev: Evaluation) -> float:
+        """Deepest indentation of the string into the wall at an evaluated state [m] (0 without contact)."""
+        wall = ev.forces.get("wall")
+        return float(wall.indentation.max(initial=0.0)) if wall is not None else 0.0
 
     def _contact(self, ev: Evaluation, previous: np.ndarray) -> np.ndarray:
         """Vertices in contact with the wall at an evaluated state (``previous`` when contact is off)."""
@@ -111,6 +117,8 @@ class Simulation:
             self.stats["steps"] += 1
             self.stats["min_dt"] = min(self.stats["min_dt"], dt)
             self.stats["max_dt"] = max(self.stats["max_dt"], dt)
+            self.stats["forced_steps"] = self.controller.forced_steps
+            self.stats["max_penetration"] = max(self.stats["max_penetration"], self._penetration(new_ev))
             state, ev, powers, in_contact = new, new_ev, new_powers, new_contact
             self.last_state = state
             if on_step is not None:

@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+import time
+from pathlib import Path
+
 from fenics_drill.forms import FIELD_NAMES
+from fenics_drill.io.files import write_json
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.modes import ModalBasis, family_counts, select_modes, solve_modes
+from fenics_drill.studies.lifecycle import command_output
 
 
 def scene_modes(scene) -> tuple[BeamDiscretization, ModalBasis, list[int]]:
@@ -45,3 +50,14 @@ def modal_report(scene) -> dict:
         "modes": modes,
         "reduced_basis": reduced,
     }
+
+
+def write_modal_report(scene, out: str | Path, overwrite: bool = False) -> dict:
+    """``fenics-drill modal``: DIR/modes.json (the report) and DIR/summary.json (status, wall time)."""
+    with command_output(out, "modal", overwrite) as summary:
+        start = time.perf_counter()
+        report = modal_report(scene)
+        report["wall_time_s"] = time.perf_counter() - start
+        write_json(Path(out) / "modes.json", report)
+        summary["message"] = "modes.json"
+    return report

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from fenics_drill.io.files import UnreadableFile, usable_result
 from fenics_drill.io.realisations import NOMINAL, read_realisation, realisation_path, write_realisation
 from fenics_drill.io.study_directory import all_done, claim
 from fenics_drill.studies.prepare import prepare, run_realisation
@@ -29,8 +30,13 @@ from fenics_drill.studies.uncertainty import BitRockLaws
 def _progress(out: Path, samples: int, started: float, done_at_start: int) -> None:
     files = sorted((out / "realisations").glob("*.h5"))
     done = len(files)
-    total_q = sum(read_realisation(p, histories=False)["q_norm_integral"] for p in files)
-    metric = np.sqrt(total_q / done) if done else float("nan")
+    q_norms = []
+    for path in files:
+        try:
+            q_norms.append(read_realisation(path, histories=False)["q_norm_integral"])
+        except UnreadableFile:
+            pass  # being replaced by --resume, or named when the statistics are assembled
+    metric = np.sqrt(sum(q_norms) / len(q_norms)) if q_norms else float("nan")
     rate = (done - done_at_start) / (time.perf_counter() - started)
     eta = (samples - done) / rate if rate > 0 else float("nan")
     sys.stderr.write(f"\r  realisations {done:5d} / {samples}  conv_MC {metric:.6e}  eta {eta:8.0f} s ")
@@ -38,23 +44,25 @@ def _progress(out: Path, samples: int, started: float, done_at_start: int) -> No
 
 
 def monte_carlo(scene, samples: int, out: str | Path, resume: bool = False, progress: bool = True,
-                comm=MPI.COMM_WORLD) -> dict | None:
+                comm=MPI.COMM_WORLD, overwrite: bool = False) -> dict | None:
     """Run (or finish) the study; rank 0 returns the summary, the other ranks None."""
     out = Path(out)
     laws = BitRockLaws(scene.bit_rock, scene.uncertainty)  # refuses inadmissible laws
-    claim(out, scene.to_dict(), "realisations", "*.h5", resume, comm)
-    prepared = prepare(scene)
-    if comm.rank == 0 and not (out / NOMINAL).exists():
-        write_realisation(out / NOMINAL, run_realisation(prepared, scene))
-    done_at_start = len(list((out / "realisations").glob("*.h5")))
-    started = time.perf_counter()
-    for k in range(comm.rank, samples, comm.size):
-        path = realisation_path(out, k)
-        if path.exists():
-            continue
-        write_realisation(path, run_realisation(prepared, scene.with_changes(bit_rock=laws.sample(k))))
-        if progress and comm.rank == 0:
-            _progress(out, samples, started, done_at_start)
-    if not all_done(comm, progress):
-        return None
-    return write_statistics(out, samples)
+    with claim(out, scene.to_dict(), "mc", resume, overwrite, comm):
+        (out / "realisations").mkdir(exist_ok=True)
+        comm.Barrier()
+        prepared = prepare(scene)
+        if comm.rank == 0 and not usable_result(out / NOMINAL, read_realisation):
+            write_realisation(out / NOMINAL, run_realisation(prepared, scene))
+        done_at_start = len(list((out / "realisations").glob("*.h5")))
+        started = time.perf_counter()
+        for k in range(comm.rank, samples, comm.size):
+            path = realisation_path(out, k)
+            if usable_result(path, read_realisation):
+                continue
+            write_realisation(path, run_realisation(prepared, scene.with_changes(bit_rock=laws.sample(k))))
+            if progress and comm.rank == 0:
+                _progress(out, samples, started, done_at_start)
+        if not all_done(comm, progress):
+            return None
+        return write_statistics(out, samples)

@@ -20,7 +20,6 @@ drive speeds nor on the bit-rock parameters.
 from __future__ import annotations
 
 import dataclasses
-import json
 import sys
 import time
 from pathlib import Path
@@ -29,7 +28,8 @@ import numpy as np
 from mpi4py import MPI
 from scipy import interpolate, optimize
 
-from fenics_drill.io.study_directory import all_done, claim, write_atomic
+from fenics_drill.io.files import read_json, usable_result, write_json
+from fenics_drill.io.study_directory import all_done, claim
 from fenics_drill.studies.prepare import prepare, run_realisation
 from fenics_drill.studies.uncertainty import BitRockLaws
 
@@ -88,7 +88,7 @@ def assemble(scene, out: Path) -> dict:
     failed = 0
     for i in range(len(v0)):
         for j in range(len(omega)):
-            results = [json.loads(_task_path(out, i * len(omega) + j, d).read_text()) for d in draws]
+            results = [read_json(_task_path(out, i * len(omega) + j, d)) for d in draws]
             finished = [r for r in results if r["status"] == "finished"]
             failed += len(results) - len(finished)
             if not finished:
@@ -123,32 +123,46 @@ def assemble(scene, out: Path) -> dict:
         report["optimum"] = None
         report["message"] = ("no admissible point in the window: the von Mises constraint "
                              f"({'(100)' if opt.samples == 0 else '(104)'}) fails everywhere")
-    (out / "optimize.json").write_text(json.dumps(report, indent=1, default=float))
+    write_json(out / "optimize.json", report)
+    write_json(out / "summary.json", {"command": "optimize", "status": "finished", "feasible": report["feasible"],
+                                      "optimum": report["optimum"], "failed_runs": failed})
     return report
 
 
+def _tasks(n_v0: int, n_omega: int, draws: int):
+    """(task number, point, i, j, draw) of every run of the window, in order, without storing them."""
+    n = 0
+    for i in range(n_v0):
+        for j in range(n_omega):
+            for draw in range(draws) if draws else (NOMINAL_DRAW,):
+                yield n, i * n_omega + j, i, j, draw
+                n += 1
+
+
 def run_optimize(scene, out: str | Path, resume: bool = False, progress: bool = True,
-                 comm=MPI.COMM_WORLD) -> dict | None:
+                 comm=MPI.COMM_WORLD, overwrite: bool = False) -> dict | None:
     """Evaluate the window (spread over the ranks) and assemble the report on rank 0."""
     out = Path(out)
     opt = scene.optimize
     laws = BitRockLaws(scene.bit_rock, scene.uncertainty) if opt.samples > 0 else None
     v0, omega = grid_axis(opt.axial_velocity), grid_axis(opt.rotation_speed)
-    draws = [NOMINAL_DRAW] if opt.samples == 0 else list(range(opt.samples))
-    tasks = [(i * len(omega) + j, v0[i], omega[j], d) for i in range(len(v0)) for j in range(len(omega)) for d in draws]
-    claim(out, scene.to_dict(), "points", "*.json", resume, comm)
-    prepared = prepare(scene)
-    started = time.perf_counter()
-    for n, (point, a, b, draw) in enumerate(tasks):
-        if n % comm.size != comm.rank or _task_path(out, point, draw).exists():
-            continue
-        bit_rock = dataclasses.asdict(scene.bit_rock) if draw == NOMINAL_DRAW else laws.sample(draw)
-        result = _evaluate(prepared, scene, a, b, bit_rock)
-        write_atomic(_task_path(out, point, draw), lambda tmp: tmp.write_text(json.dumps(result, default=float)))
-        if progress and comm.rank == 0:
-            done = len(list((out / "points").glob("*.json")))
-            sys.stderr.write(f"\r  runs {done:5d} / {len(tasks)}  wall {time.perf_counter() - started:8.1f} s ")
-            sys.stderr.flush()
-    if not all_done(comm, progress):
-        return None
-    return assemble(scene, out)
+    total = len(v0) * len(omega) * max(opt.samples, 1)
+    with claim(out, scene.to_dict(), "optimize", resume, overwrite, comm):
+        (out / "points").mkdir(exist_ok=True)
+        comm.Barrier()
+        prepared = prepare(scene)
+        started = time.perf_counter()
+        for n, point, i, j, draw in _tasks(len(v0), len(omega), opt.samples):
+            path = _task_path(out, point, draw)
+            if n % comm.size != comm.rank or usable_result(path, read_json):
+                continue
+            bit_rock = dataclasses.asdict(scene.bit_rock) if draw == NOMINAL_DRAW else laws.sample(draw)
+            result = _evaluate(prepared, scene, v0[i], omega[j], bit_rock)
+            write_json(path, result)
+            if progress and comm.rank == 0:
+                done = len(list((out / "points").glob("*.json")))
+                sys.stderr.write(f"\r  runs {done:5d} / {total}  wall {time.perf_counter() - started:8.1f} s ")
+                sys.stderr.flush()
+        if not all_done(comm, progress):
+            return None
+        return assemble(scene, out)

@@ -9,6 +9,7 @@ ends (finished, failed with the reason, or interrupted with Ctrl-C) and says whi
 from __future__ import annotations
 
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -16,7 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from fenics_drill.io.fields import FieldWriter
-from fenics_drill.io.json_files import write_json
+from fenics_drill.io.files import write_json
+from fenics_drill.io.output_directory import claim_output
 from fenics_drill.io.timeseries import TimeSeriesWriter, read_series
 from fenics_drill.model.drillstring import DrillstringModel, build_model
 from fenics_drill.observables.drilling_quantities import drilling_quantities
@@ -24,21 +26,29 @@ from fenics_drill.observables.step_rows import StepRows
 from fenics_drill.solvers.static import StaticFailure, solve_static, static_report
 from fenics_drill.solvers.step_control import StepTooSmall, nominal_step
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
+from fenics_drill.studies.lifecycle import StopOnSignal, command_output
 from fenics_drill.studies.prepare import prepare
 
 
-def run_static(scene, out: str | Path) -> dict:
-    """Static equilibrium of the scene (Section 6.4): DIR/static.json and DIR/static.xdmf."""
+#: A run whose string went deeper into the wall than this share of the gap is reported "suspect": the
+#: Hunt-Crossley law (17) models a stiff wall, so a deep penetration means the time step or the contact
+#: stiffness does not resolve the impacts.
+PENETRATION_LIMIT = 0.1
+
+
+def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
+    """Static equilibrium of the scene (Section 6.4): DIR/static.json, DIR/static.xdmf, DIR/summary.json."""
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    model = build_model(scene)
-    equilibrium = solve_static(model)
-    report = static_report(model, equilibrium)
-    report["reduced_size"] = model.size
-    writer = FieldWriter(model.disc, out / "static.xdmf")
-    writer.write(model.space.expand(equilibrium.q), 0.0)
-    writer.close()
-    write_json(out / "static.json", report)
+    with command_output(out, "static", overwrite) as summary:
+        model = build_model(scene)
+        equilibrium = solve_static(model)
+        report = static_report(model, equilibrium)
+        report["reduced_size"] = model.size
+        writer = FieldWriter(model.disc, out / "static.xdmf")
+        writer.write(model.space.expand(equilibrium.q), 0.0)
+        writer.close()
+        write_json(out / "static.json", report)
+        summary["message"] = "static.json"
     return report
 
 
@@ -65,8 +75,10 @@ class Progress:
 class RunRecorder:
     """Turns accepted steps (and the initial state) into time-series rows and XDMF snapshots."""
 
-    def __init__(self, model: DrillstringModel, scene, out: Path):
+    def __init__(self, model: DrillstringModel, scene, out: Path, on_write=None):
+        """``on_write(state)`` is called after each write of the files (the running summary)."""
         self.model = model
+        self.on_write = on_write
         self.rows = StepRows(model, scene)
         self.section_x = self.rows.section_x
         self.series = TimeSeriesWriter(out / "timeseries.h5", model.disc.vertex_x, {
@@ -87,9 +99,14 @@ class RunRecorder:
 
     def __call__(self, record: StepRecord) -> None:
         dofs = self.model.space.expand(record.state.q)
-        self.series.append(self.rows(record, dofs))
-        self.last_state = record.state
         self._write_fields(record.state.t, dofs)
+        written = self.series.append(self.rows(record, dofs))
+        self.last_state = record.state
+        if written:
+            if self.fields is not None:
+                self.fields.flush()
+            if self.on_write is not None:
+                self.on_write(record.state)
 
     def close(self, impacts_per_vertex: np.ndarray) -> None:
         self.series.close(impacts_per_vertex)
@@ -97,46 +114,83 @@ class RunRecorder:
             self.fields.close()
 
 
-def run_scene(scene, out: str | Path, progress: bool = True) -> dict:
-    """Static equilibrium, then the drilling dynamics to time.t_end; returns the summary."""
+def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = False) -> dict:
+    """Static equilibrium, then the drilling dynamics to time.t_end; returns the summary.
+
+    The output directory is taken under the policy of :mod:`fenics_drill.io.output_directory`
+    (OutputError before any computation).  While the run runs, ``summary.json`` says "running"
+    and how far it got at the last write of the files; at the end it holds the whole summary,
+    however the run ended: finished, suspect (finished, but physically doubtful: see
+    ``suspect_reasons``), failed (with when and why) or interrupted (Ctrl-C, SIGTERM)."""
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    claim = claim_output(out, "run", overwrite)
     clock = time.perf_counter()
-    summary: dict = {"status": "failed", "message": "", "t_end": 0.0, "steps": 0}
+    summary: dict = {"command": "run", "status": "failed", "message": "", "t_end": 0.0, "steps": 0}
     recorder = simulation = None
-    try:
-        prepared = prepare(scene)
-        model, equilibrium = prepared.model, prepared.equilibrium
-        summary["reduced_size"], summary["full_dofs"] = model.size, model.disc.ndofs
-        summary["setup_time_s"], summary["static"] = prepared.setup_time_s, prepared.static
-        simulation = Simulation(model, scene)
-        start = simulation.initial_state(equilibrium.q, equilibrium.mu)
-        recorder = RunRecorder(model, scene, out)
-        u0 = model.bit_state(start.q, start.qd)[0]
-        summary["nominal_dt"] = nominal_step(scene)
-        loop_clock = time.perf_counter()
+
+    def running(state) -> None:
+        write_json(out / "summary.json", {**summary, "status": "running", "pid": os.getpid(), "t_end": state.t,
+                                          "steps": simulation.stats["steps"],
+                                          "wall_time_s": time.perf_counter() - clock})
+
+    with StopOnSignal():
         try:
-            final = simulation.run(start, scene.time.t_end, recorder, Progress(progress))
-            summary["status"], summary["message"] = "finished", "reached time.t_end"
-        except StepTooSmall as failure:
-            final = None
-            summary["message"] = str(failure)
-        summary["integration_time_s"] = time.perf_counter() - loop_clock
-        last = final if final is not None else simulation.last_state
-        summary.update(_dynamics_summary(model, simulation, recorder, last, u0))
-    except KeyboardInterrupt:
-        summary["status"], summary["message"] = "interrupted", "stopped by Ctrl-C or SIGTERM"
-        if recorder is not None and recorder.last_state is not None:
-            summary.update(_dynamics_summary(model, simulation, recorder, recorder.last_state, u0))
-    except StaticFailure as failure:
-        summary["message"] = f"at t = 0 s: {failure}"
-    finally:
-        if recorder is not None:
-            recorder.close(simulation.impacts_per_vertex)
-            summary.update(quantities_of_run(out / "timeseries.h5"))
-        summary["wall_time_s"] = time.perf_counter() - clock
-        write_json(out / "summary.json", summary)
+            prepared = prepare(scene)
+            model, equilibrium = prepared.model, prepared.equilibrium
+            summary["reduced_size"], summary["full_dofs"] = model.size, model.disc.ndofs
+            summary["setup_time_s"], summary["static"] = prepared.setup_time_s, prepared.static
+            simulation = Simulation(model, scene)
+            start = simulation.initial_state(equilibrium.q, equilibrium.mu)
+            recorder = RunRecorder(model, scene, out, on_write=running)
+            u0 = model.bit_state(start.q, start.qd)[0]
+            summary["nominal_dt"] = nominal_step(scene)
+            loop_clock = time.perf_counter()
+            try:
+                final = simulation.run(start, scene.time.t_end, recorder, Progress(progress))
+                summary["status"], summary["message"] = "finished", "reached time.t_end"
+            except StepTooSmall as failure:
+                final = None
+                summary["message"] = str(failure)
+            summary["integration_time_s"] = time.perf_counter() - loop_clock
+            last = final if final is not None else simulation.last_state
+            summary.update(_dynamics_summary(model, simulation, recorder, last, u0))
+        except KeyboardInterrupt:
+            summary["status"], summary["message"] = "interrupted", "stopped by Ctrl-C or SIGTERM"
+            if recorder is not None and recorder.last_state is not None:
+                summary.update(_dynamics_summary(model, simulation, recorder, recorder.last_state, u0))
+        except StaticFailure as failure:
+            summary["message"] = f"at t = 0 s: {failure}"
+        finally:
+            if recorder is not None:
+                recorder.close(simulation.impacts_per_vertex)
+                summary.update(quantities_of_run(out / "timeseries.h5"))
+            if simulation is not None:
+                _judge_admissibility(summary, simulation, scene)
+            summary["wall_time_s"] = time.perf_counter() - clock
+            write_json(out / "summary.json", summary)
+            claim.release()
     return summary
+
+
+def _judge_admissibility(summary: dict, simulation: Simulation, scene) -> None:
+    """A finished run whose numbers cannot be trusted becomes "suspect", with its reasons."""
+    stats = simulation.stats
+    gap = scene.borehole.radius - scene.beam.outer_radius
+    summary["max_penetration"] = stats["max_penetration"]
+    summary["forced_steps"] = stats["forced_steps"]
+    reasons = []
+    if stats["max_penetration"] > PENETRATION_LIMIT * gap:
+        reasons.append(f"the string went {stats['max_penetration'] * 1e3:.3g} mm into the wall, more than "
+                       f"{PENETRATION_LIMIT:.0%} of the {gap * 1e3:.3g} mm gap: the contact stiffness or the "
+                       "time step does not resolve the impacts")
+    if stats["forced_steps"]:
+        reasons.append(f"{stats['forced_steps']} steps were accepted at the minimum step size with a local "
+                       f"error up to {simulation.controller.worst_forced_ratio:.3g} times time.error_tolerance: "
+                       "raise time.max_step_cuts or time.error_tolerance")
+    if reasons and summary["status"] == "finished":
+        summary["status"] = "suspect"
+    if reasons:
+        summary["suspect_reasons"] = reasons
 
 
 def _dynamics_summary(model, simulation: Simulation, recorder: RunRecorder, state, u0: float) -> dict:

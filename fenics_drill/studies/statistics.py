@@ -9,13 +9,13 @@ gave up) are counted and left out.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import h5py
 import numpy as np
 from scipy import stats
 
+from fenics_drill.io.files import write_json
 from fenics_drill.io.realisations import NOMINAL, read_realisation, realisation_path
 from fenics_drill.studies.prepare import HISTORIES
 
@@ -99,5 +99,5 @@ def write_statistics(out: Path, samples: int) -> dict:
         **{key: _scalar_summary(values) for key, values in scalars.items()},
         "wall_time_per_realisation_s": float(np.mean([r["wall_time_s"] for r in results])),
     }
-    (out / "summary.json").write_text(json.dumps(summary, indent=1))
+    write_json(out / "summary.json", {"command": "mc", "status": "finished", **summary})
     return summary

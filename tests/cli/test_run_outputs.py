@@ -3,6 +3,7 @@
 import json
 
 import h5py
+import meshio
 import numpy as np
 import pytest
 import xarray as xr
@@ -39,11 +40,19 @@ def test_run_writes_summary_timeseries_and_fields(tmp_path):
     assert u[-1] - u[0] == pytest.approx(travel, rel=0.05)
     xdmf = (tmp_path / "fields.xdmf").read_text()
     with h5py.File(tmp_path / "fields.h5") as f:
-        assert set(f["Function"]) == {"u", "v", "w", "theta_x", "theta_y", "theta_z", "von_mises"}
+        assert set(f["Function"]) == {"u", "v", "w", "theta_x", "theta_y", "theta_z", "displacement", "von_mises"}
         snapshots = list(f["Function/w"])
         assert len(snapshots) == 6  # t = 0, 0.01, ..., 0.05
         assert f["Function/w"][snapshots[0]].shape[0] == 11  # P1: one value per vertex
     assert 'Name="w"' in xdmf and 'Name="theta_x"' in xdmf
+    # the XDMF index opens as a time series (meshio reads it the way ParaView's XDMF reader does)
+    reader = meshio.xdmf.TimeSeriesReader(tmp_path / "fields.xdmf")
+    points, cells = reader.read_points_cells()
+    assert points.shape == (11, 3) and cells[0].type == "line" and len(cells[0].data) == 10
+    assert reader.num_steps == 6
+    t_last, point_data, cell_data = reader.read_data(reader.num_steps - 1)
+    assert t_last == pytest.approx(0.05) and point_data["displacement"].shape == (11, 3)
+    assert cell_data["von_mises"][0].shape == (10, 1)
     # fenics-drill plot: every figure, the spectra and the animation from the saved files alone
     assert main(["plot", str(tmp_path)]) == 0
     for name in ("fig13_static_3d", "fig14_bit_axial", "fig17_section_radial", "fig19_impacts_position",

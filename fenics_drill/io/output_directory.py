@@ -1,0 +1,154 @@
+"""The policy for output directories (``--out``), one for every command.
+
+* A directory belongs to the command that wrote it: ``summary.json`` names the command
+  (``run``, ``static``, ``modal``, ``mc``, ``optimize``) from the moment it starts.  A
+  command never writes into another command's directory.
+* A directory that already holds the output of the same command is refused unless the
+  user says ``--overwrite`` (then every file that command owns is removed first, and
+  nothing else) or, for a study, ``--resume`` (continue it).
+* A directory with files that are not a command's output is never touched.
+* One process at a time: an exclusive lock (``.fenics-drill.lock``, released by the
+  kernel when the process dies) refuses a second command on the same directory.
+* While the command works, ``summary.json`` says ``"status": "running"`` with its pid.
+
+Every refusal is an :class:`OutputError` naming the directory and the remedy.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import shutil
+import time
+from pathlib import Path
+
+from fenics_drill.io.files import UnreadableFile, read_json, write_json
+
+LOCK_NAME = ".fenics-drill.lock"
+
+#: What each command owns in its directory (glob patterns), and what marks a directory as its own
+#: when an older version wrote no ``command`` into ``summary.json``.
+OWNED = {
+    "run": ("summary.json", "timeseries.h5", "fields.xdmf", "fields.h5", "fig*.png", "spectra.json",
+            "animation.gif"),
+    "static": ("summary.json", "static.json", "static.xdmf", "static.h5"),
+    "modal": ("summary.json", "modes.json"),
+    "mc": ("summary.json", "scene.json", "nominal.h5", "realisations", "statistics.h5", "fig*.png"),
+    "optimize": ("summary.json", "scene.json", "points", "optimize.json", "fig*.png"),
+}
+SIGNATURE = {"run": "timeseries.h5", "static": "static.json", "modal": "modes.json", "mc": "realisations",
+             "optimize": "points"}
+DESCRIPTION = {"run": "a drilling run", "static": "a static equilibrium", "modal": "a modal analysis",
+               "mc": "a Monte Carlo study", "optimize": "an operating-window study"}
+
+
+class OutputError(ValueError):
+    """An output directory that cannot be used; the message names it and says what to do."""
+
+
+def directory_kind(out: Path) -> str | None:
+    """The command whose output ``out`` holds (None if it holds none)."""
+    summary = out / "summary.json"
+    if summary.is_file():
+        try:
+            command = read_json(summary).get("command")
+        except UnreadableFile:
+            command = None
+        if command in OWNED:
+            return command
+    for command, marker in SIGNATURE.items():
+        if (out / marker).exists():
+            return command
+    return None
+
+
+def owned_paths(out: Path, command: str) -> list[Path]:
+    """The files and folders of ``out`` that ``command`` owns (its outputs and their temporary files)."""
+    paths = {p for pattern in OWNED[command] for p in out.glob(pattern)}
+    paths |= set(out.glob(".*.tmp*"))
+    return sorted(paths)
+
+
+def _foreign(out: Path, command: str | None) -> list[Path]:
+    """Entries of ``out`` that no command owns (hidden files aside)."""
+    mine = set(owned_paths(out, command)) if command else set()
+    return [p for p in out.iterdir() if not p.name.startswith(".") and p not in mine]
+
+
+class OutputClaim:
+    """An output directory held by this process: the lock stays until :meth:`release` or exit."""
+
+    def __init__(self, out: Path, command: str, lock_file):
+        self.out, self.command, self._lock = out, command, lock_file
+
+    def __enter__(self) -> "OutputClaim":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+    def release(self) -> None:
+        """Give the directory back (idempotent; a claim without a lock, as on MPI ranks > 0, holds nothing)."""
+        if self._lock is not None:
+            fcntl.flock(self._lock, fcntl.LOCK_UN)
+            self._lock.close()
+            self._lock = None
+
+
+def _lock(out: Path):
+    path = out / LOCK_NAME
+    try:
+        handle = open(path, "a+")
+    except OSError as err:
+        raise OutputError(f"--out {out} is not writable: {err.strerror}") from err
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as err:
+        handle.seek(0)
+        holder = handle.read().strip() or "unknown"
+        handle.close()
+        raise OutputError(f"--out {out} is in use by another fenics-drill process (pid {holder}): wait for "
+                          "it or choose another --out") from err
+    handle.seek(0)
+    handle.truncate()
+    handle.write(str(os.getpid()))
+    handle.flush()
+    return handle
+
+
+def claim_output(out: str | Path, command: str, overwrite: bool = False, resume: bool = False,
+                 record: dict | None = None) -> OutputClaim:
+    """Take ``out`` for ``command`` under the policy of this module; write the "running" summary
+    (with ``record`` added).  ``resume`` (studies only) keeps what an earlier run of the study wrote."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"--out {out} is a file, not a directory: choose a directory")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise OutputError(f"cannot create --out {out}: {err.strerror}") from err
+    lock = _lock(out)
+    try:
+        kind = directory_kind(out)
+        if kind is not None and kind != command:
+            raise OutputError(f"--out {out} holds {DESCRIPTION[kind]} ('fenics-drill {kind}'); 'fenics-drill "
+                              f"{command}' never writes into another command's directory: choose another --out")
+        foreign = _foreign(out, kind)
+        if foreign:
+            names = ", ".join(p.name for p in foreign[:5])
+            raise OutputError(f"--out {out} holds files that are not fenics-drill output ({names}): choose an "
+                              "empty or new directory")
+        if kind == command and not resume:
+            if not overwrite:
+                remedy = " or --resume to continue it" if command in ("mc", "optimize") else ""
+                raise OutputError(f"--out {out} already holds {DESCRIPTION[kind]}: add --overwrite to replace "
+                                  f"it{remedy}, or choose another --out")
+            for path in owned_paths(out, command):
+                shutil.rmtree(path) if path.is_dir() else path.unlink()
+        write_json(out / "summary.json", {"command": command, "status": "running", "pid": os.getpid(),
+                                          "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), **(record or {})})
+    except BaseException:
+        fcntl.flock(lock, fcntl.LOCK_UN)
+        lock.close()
+        raise
+    return OutputClaim(out, command, lock)
