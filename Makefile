@@ -12,14 +12,14 @@ setup:
 ## T_END=1 make demo runs a short version.
 T_END ?= 10.0
 demo: setup
-	$(PY) -m fenics_drill.cli run demos/scenes/paper.toml --set time.t_end=$(T_END) --out $(OUT)/nominal
+	$(PY) -m fenics_drill.cli run demos/scenes/paper.toml --set time.t_end=$(T_END) --overwrite --out $(OUT)/nominal
 	$(PY) -m fenics_drill.cli plot $(OUT)/nominal
-	$(PY) -m fenics_drill.cli modal demos/scenes/paper.toml --out $(OUT)/paper
+	$(PY) -m fenics_drill.cli modal demos/scenes/paper.toml --overwrite --out $(OUT)/paper
 	$(PY) demos/modal_distributions.py --out $(OUT)/modal-distributions
 
 ## The paper's kinematics (14) as printed: the run that reproduces its shock packages (docs/verification.md).
 demo-printed: setup
-	$(PY) -m fenics_drill.cli run demos/scenes/paper.toml --set time.t_end=$(T_END) --set model.kinematics=printed --out $(OUT)/nominal-printed
+	$(PY) -m fenics_drill.cli run demos/scenes/paper.toml --set time.t_end=$(T_END) --set model.kinematics=printed --overwrite --out $(OUT)/nominal-printed
 	$(PY) -m fenics_drill.cli plot $(OUT)/nominal-printed
 
 ## The test suite (a few minutes on 2 cores).

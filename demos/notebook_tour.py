@@ -54,7 +54,7 @@ print(f"max sag {rest['max_sag'] * 1e3:.2f} mm of a {rest['gap'] * 1e3:.0f} mm g
 # `fd.run` writes the run's files (summary, time series, ParaView fields) into a directory
 # and returns the summary and the time series as an `xarray.Dataset`.
 
-run = fd.run(scene, out=out / "run")
+run = fd.run(scene, out=out / "run", overwrite=True)  # overwrite: replace the run of an earlier tour
 print(f"{run.summary['status']}: rop {run.summary['rop'] * 3600:.2f} m/h, "
       f"efficiency {run.summary['efficiency']:.1%}, max von Mises {run.summary['max_von_mises']['value'] / 1e6:.1f} MPa")
 series = run.series

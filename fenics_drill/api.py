@@ -47,29 +47,31 @@ def modal_analysis(scene: Scene) -> dict:
     return modal_report(scene)
 
 
-def static_state(scene: Scene, out: str | Path | None = None) -> dict:
+def static_state(scene: Scene, out: str | Path | None = None, overwrite: bool = False) -> dict:
     """Static equilibrium under gravity with wall contact (Section 6.4): static.json; with ``out`` also
     static.xdmf there."""
     if out is not None:
-        return run_static(scene, out)
+        return run_static(scene, out, overwrite=overwrite)
     return prepare(scene).static
 
 
-def run(scene: Scene, out: str | Path | None = None, progress: bool = False) -> RunResult:
+def run(scene: Scene, out: str | Path | None = None, progress: bool = False, overwrite: bool = False) -> RunResult:
     """Static equilibrium, then the drilling dynamics to ``time.t_end`` into ``out`` (a new temporary
-    directory if None)."""
+    directory if None; an earlier run there is replaced only with ``overwrite``)."""
     directory = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="fenics-drill-run-"))
-    return RunResult(directory, run_scene(scene, directory, progress=progress))
+    return RunResult(directory, run_scene(scene, directory, progress=progress, overwrite=overwrite))
 
 
-def monte_carlo(scene: Scene, samples: int, out: str | Path, resume: bool = False, progress: bool = False) -> dict:
+def monte_carlo(scene: Scene, samples: int, out: str | Path, resume: bool = False, progress: bool = False,
+                overwrite: bool = False) -> dict:
     """Monte Carlo over the random bit-rock laws (Section 6.11): the summary of ``out``/summary.json."""
-    return _monte_carlo(scene, samples, out, resume=resume, progress=progress)
+    return _monte_carlo(scene, samples, out, resume=resume, progress=progress, overwrite=overwrite)
 
 
-def operating_window(scene: Scene, out: str | Path, resume: bool = False, progress: bool = False) -> dict:
+def operating_window(scene: Scene, out: str | Path, resume: bool = False, progress: bool = False,
+                     overwrite: bool = False) -> dict:
     """The operating window of the scene's [optimize] section (Sections 6.9-6.12): optimize.json."""
-    return run_optimize(scene, out, resume=resume, progress=progress)
+    return run_optimize(scene, out, resume=resume, progress=progress, overwrite=overwrite)
 
 
 def plot(directory: str | Path, gif: bool = False) -> list[Path]:

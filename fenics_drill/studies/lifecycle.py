@@ -18,6 +18,7 @@ from pathlib import Path
 
 from fenics_drill.io.files import write_json
 from fenics_drill.io.output_directory import claim_output
+from fenics_drill.model.resources import check_memory
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
@@ -47,11 +48,13 @@ class StopOnSignal:
 
 
 @contextmanager
-def command_output(out: str | Path, command: str, overwrite: bool = False):
-    """Take ``out`` for ``command`` (OutputError before any computation) and yield the summary dict the
-    command fills; on the way out ``summary.json`` is written with the status: finished, interrupted
-    (SIGINT, SIGTERM) or failed (with the exception's message)."""
+def command_output(out: str | Path, command: str, scene, overwrite: bool = False):
+    """Check that the scene fits in memory (ResourceError), take ``out`` for ``command`` (OutputError),
+    both before any computation, and yield the summary dict the command fills; on the way out
+    ``summary.json`` is written with the status: finished, interrupted (SIGINT, SIGTERM) or failed
+    (with the exception's message)."""
     out = Path(out)
+    check_memory(scene.beam.elements, scene.beam.element_degree)
     claim = claim_output(out, command, overwrite)
     start = time.perf_counter()
     summary = {"command": command, "status": "finished", "message": ""}

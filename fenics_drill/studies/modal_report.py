@@ -54,7 +54,7 @@ def modal_report(scene) -> dict:
 
 def write_modal_report(scene, out: str | Path, overwrite: bool = False) -> dict:
     """``fenics-drill modal``: DIR/modes.json (the report) and DIR/summary.json (status, wall time)."""
-    with command_output(out, "modal", overwrite) as summary:
+    with command_output(out, "modal", scene, overwrite) as summary:
         start = time.perf_counter()
         report = modal_report(scene)
         report["wall_time_s"] = time.perf_counter() - start

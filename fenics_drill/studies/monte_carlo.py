@@ -22,6 +22,7 @@ from mpi4py import MPI
 from fenics_drill.io.files import UnreadableFile, usable_result
 from fenics_drill.io.realisations import NOMINAL, read_realisation, realisation_path, write_realisation
 from fenics_drill.io.study_directory import all_done, claim
+from fenics_drill.model.resources import check_memory
 from fenics_drill.studies.prepare import prepare, run_realisation
 from fenics_drill.studies.statistics import write_statistics
 from fenics_drill.studies.uncertainty import BitRockLaws
@@ -48,6 +49,7 @@ def monte_carlo(scene, samples: int, out: str | Path, resume: bool = False, prog
     """Run (or finish) the study; rank 0 returns the summary, the other ranks None."""
     out = Path(out)
     laws = BitRockLaws(scene.bit_rock, scene.uncertainty)  # refuses inadmissible laws
+    check_memory(scene.beam.elements, scene.beam.element_degree)
     with claim(out, scene.to_dict(), "mc", resume, overwrite, comm):
         (out / "realisations").mkdir(exist_ok=True)
         comm.Barrier()

@@ -30,6 +30,7 @@ from scipy import interpolate, optimize
 
 from fenics_drill.io.files import read_json, usable_result, write_json
 from fenics_drill.io.study_directory import all_done, claim
+from fenics_drill.model.resources import check_memory
 from fenics_drill.studies.prepare import prepare, run_realisation
 from fenics_drill.studies.uncertainty import BitRockLaws
 
@@ -147,6 +148,7 @@ def run_optimize(scene, out: str | Path, resume: bool = False, progress: bool = 
     laws = BitRockLaws(scene.bit_rock, scene.uncertainty) if opt.samples > 0 else None
     v0, omega = grid_axis(opt.axial_velocity), grid_axis(opt.rotation_speed)
     total = len(v0) * len(omega) * max(opt.samples, 1)
+    check_memory(scene.beam.elements, scene.beam.element_degree)
     with claim(out, scene.to_dict(), "optimize", resume, overwrite, comm):
         (out / "points").mkdir(exist_ok=True)
         comm.Barrier()

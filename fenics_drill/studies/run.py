@@ -21,6 +21,7 @@ from fenics_drill.io.files import write_json
 from fenics_drill.io.output_directory import claim_output
 from fenics_drill.io.timeseries import TimeSeriesWriter, read_series
 from fenics_drill.model.drillstring import DrillstringModel, build_model
+from fenics_drill.model.resources import check_memory
 from fenics_drill.observables.drilling_quantities import drilling_quantities
 from fenics_drill.observables.step_rows import StepRows
 from fenics_drill.solvers.static import StaticFailure, solve_static, static_report
@@ -39,7 +40,7 @@ PENETRATION_LIMIT = 0.1
 def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
     """Static equilibrium of the scene (Section 6.4): DIR/static.json, DIR/static.xdmf, DIR/summary.json."""
     out = Path(out)
-    with command_output(out, "static", overwrite) as summary:
+    with command_output(out, "static", scene, overwrite) as summary:
         model = build_model(scene)
         equilibrium = solve_static(model)
         report = static_report(model, equilibrium)
@@ -123,6 +124,7 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
     however the run ended: finished, suspect (finished, but physically doubtful: see
     ``suspect_reasons``), failed (with when and why) or interrupted (Ctrl-C, SIGTERM)."""
     out = Path(out)
+    check_memory(scene.beam.elements, scene.beam.element_degree)
     claim = claim_output(out, "run", overwrite)
     clock = time.perf_counter()
     summary: dict = {"command": "run", "status": "failed", "message": "", "t_end": 0.0, "steps": 0}
