@@ -72,7 +72,7 @@ class Beam:
     elements: int = key(250, "number of finite elements [-]; 250 sits on the Pareto front of the modal "
                         "models (the paper's 500 gives the same drilling quantities to 5 digits at 1.7x the cost, "
                         "benchmarks/RESULTS.md); the full order needs 500-1000", lambda n: n >= 1, ">= 1")
-    element_degree: int = key(2, "polynomial degree of v, w; u and the rotations use one degree less [-]",
+    element_degree: int = key(2, "polynomial degree of u, v, w; the rotations use one degree less [-]",
                               lambda k: 2 <= k <= 5, "an integer in [2, 5]")
     outer_radius: float = _pos("outer radius R_ext [m]", 80e-3)
     inner_radius: float = _nonneg("inner radius R_int [m]", 50e-3)

@@ -21,9 +21,9 @@ class ResourceError(ValueError):
 
 
 def dof_count(elements: int, element_degree: int) -> int:
-    """Unknowns of the mixed space: v, w of degree k, u and the rotations of degree k - 1."""
+    """Unknowns of the mixed space: u, v, w of degree k, the rotations of degree k - 1."""
     k = element_degree
-    return 2 * (k * elements + 1) + 4 * ((k - 1) * elements + 1)
+    return 3 * (k * elements + 1) + 3 * ((k - 1) * elements + 1)
 
 
 def estimated_memory(elements: int, element_degree: int) -> float:
