@@ -224,10 +224,11 @@ def _user_errors() -> tuple[type, ...]:
     from fenics_drill.io.files import UnreadableFile
     from fenics_drill.io.output_directory import OutputError
     from fenics_drill.model.resources import ResourceError
+    from fenics_drill.model.spaces import BasisError
     from fenics_drill.plots.directory import NothingToPlot
     from fenics_drill.studies.uncertainty import InadmissibleLaw
 
-    return SceneError, OutputError, ResourceError, UnreadableFile, InadmissibleLaw, NothingToPlot
+    return SceneError, OutputError, ResourceError, UnreadableFile, InadmissibleLaw, NothingToPlot, BasisError
 
 
 def _collective_errors() -> tuple[type, ...]:

@@ -173,8 +173,13 @@ class Reduction:
     flexural: float = _band_or_count("flexural f* upper bound ('band') or mode count ('count')")
     torsional: float = _band_or_count("torsional f* upper bound ('band') or mode count ('count')")
     axial: float = _band_or_count("axial f* upper bound ('band') or mode count ('count')")
-    static_correction: bool = key(False, "add the static responses to a unit bit force and torque to the modal "
-                                  "basis (fenics_drill/model/enrichment.py); false: the paper's pure modal basis")
+    enrich: bool = key(True, "add to the basis the static response of every load it misses beyond "
+                       "reduction.guard_tolerance, with its axial companion (fenics_drill/model/enrichment.py); "
+                       "false: a basis missing a load beyond the tolerance stops the command")
+    guard_tolerance: float = key(0.03, "largest admissible share of a load's static response the basis may miss "
+                                 "(square root of the missed strain-energy share; 0.03 = 0.1 % of the energy); 1 "
+                                 "accepts any basis (the paper's pure modal basis with enrich = false)",
+                                 lambda x: 0 < x <= 1, "in (0, 1]")
 
 
 @dataclass(frozen=True)

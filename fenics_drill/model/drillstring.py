@@ -25,7 +25,8 @@ from fenics_drill.model.discretization import THETA_X, U, V, W, BeamDiscretizati
 from fenics_drill.model.forces import ForceEvaluation, build_forces
 from fenics_drill.model.internal_force import internal_force
 from fenics_drill.model.operators import LinearOperators, assemble_linear
-from fenics_drill.model.spaces import solution_space
+from fenics_drill.model.enrichment import augment
+from fenics_drill.model.spaces import FullSpace, ModalSpace, solution_space
 
 
 @dataclass
@@ -44,9 +45,10 @@ class DrillstringModel:
     """Operators, point forces and constraints of one scene in one solution space."""
 
     def __init__(self, scene, disc: BeamDiscretization, space, operators: LinearOperators, basis=None,
-                 modes=None):
+                 modes=None, guard=None):
         self.scene, self.disc, self.space, self.basis = scene, disc, space, basis
         self.modes = modes  # every mode of the band B, kept or not (to name spectral peaks)
+        self.guard = guard or {}  # per load: share of its static response the modes / the basis miss
         self.gap = scene.borehole.radius - disc.properties.outer_radius
         self.mass = space.project_matrix(operators.mass)
         self.internal = internal_force(disc, space, operators, scene.model)
@@ -57,7 +59,7 @@ class DrillstringModel:
         self.drive_rate = np.array([scene.drive.axial_velocity, scene.drive.rotation_speed])
         self.lateral_rows = (space.rows(disc.vertex_dofs(V)), space.rows(disc.vertex_dofs(W)))
         self.bit_rows = space.rows([disc.end_dof(U, 1), disc.end_dof(THETA_X, 1)])
-        self._operators = operators
+        self.operators = operators
 
     @property
     def size(self) -> int:
@@ -84,13 +86,25 @@ class DrillstringModel:
         model.drive_rate = np.array([axial_velocity, rotation_speed])
         return model
 
+    def full_order(self) -> "DrillstringModel":
+        """The same string in the full finite-element space (no modal reduction), sharing the operators."""
+        return DrillstringModel(self.scene, self.disc, FullSpace(self.disc.ndofs, self.disc.support_dofs),
+                                self.operators, None, self.modes, {})
+
+    def with_vectors(self, vectors: np.ndarray, guard: dict) -> "DrillstringModel":
+        """A model whose modal basis also spans the full-space ``vectors`` (M-orthonormalised), with the
+        guard's report ``guard``."""
+        phi = augment(self.space.phi, vectors, self.operators.mass)
+        return DrillstringModel(self.scene, self.disc, ModalSpace(phi), self.operators, self.basis, self.modes,
+                                guard)
+
     def drive_velocity_field(self) -> np.ndarray:
         """Initial velocity of Section 3.2 in reduced coordinates: u_dot = V0, theta_x_dot = Omega,
         projected with the mass as in (54) (exact: both are rigid-body motions)."""
         full = np.zeros(self.disc.ndofs)
         full[self.disc.field_dofs[U]] = self.drive_rate[0]
         full[self.disc.field_dofs[THETA_X]] = self.drive_rate[1]
-        return self.space.solve(self.mass, self.space.project(self._operators.mass @ full))
+        return self.space.solve(self.mass, self.space.project(self.operators.mass @ full))
 
     def evaluate(self, q, qd, qdd, mu, tangent_coefficients=None, internal_parts=None) -> Evaluation:
         """Residual at (q, qd, qdd, mu); with (c_u, c_v, c_a) also the tangent.
@@ -139,5 +153,5 @@ def build_model(scene) -> DrillstringModel:
     """Discretize, solve the modal problem, choose the basis and build the model of a scene."""
     disc = BeamDiscretization.from_scene(scene)
     operators = assemble_linear(disc)
-    space, basis, modes = solution_space(scene, disc, operators)
-    return DrillstringModel(scene, disc, space, operators, basis, modes)
+    space, basis, modes, guard = solution_space(scene, disc, operators)
+    return DrillstringModel(scene, disc, space, operators, basis, modes, guard)

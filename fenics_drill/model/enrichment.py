@@ -1,43 +1,179 @@
-"""Static correction of a truncated modal basis for the loads at the bit (modal truncation
-augmentation).
+"""The guard and the enrichment of a truncated modal basis (Section 6.3 made safe).
 
-A basis of the lowest modes reproduces a load's dynamic response but not the
-quasi-static deflection owed to the modes left out: for a point force at the tip of a
-bar, the axial modes with f* <= 4 carry only 95 % of the static tip displacement
-(benchmarks/dynamics_convergence.md).  The bit-rock force (20) and torque (21) are
-such point loads, so the basis is augmented with the static responses to a unit
-axial force and a unit torque at x = L, the drive end u(0), theta_x(0) held (where
-the multipliers hold it), M-orthogonalised against the modes and M-normalised.
+A basis of the lowest modes reproduces a load's dynamic response but not always its
+quasi-static deflection: the modes left out may hold most of it.  A 6 m string has no
+flexural mode below the paper's 5 Hz band, so its sag under gravity is zero in the
+paper's basis; a point force at the bit loses 5 % of the tip compliance of a bar to the
+axial modes above f* = 4.  The guard measures, for every load the scene applies, how
+much of its static response the basis misses, in the energy norm of the linear
+stiffness K, with the drive end u(0), theta_x(0) held where the multipliers hold it:
+
+    error^2 = 1 - f . u_basis / f . u,    u = K^-1 f,  u_basis its Galerkin projection,
+
+which is the share of the static strain energy the basis cannot carry.  The loads are
+gravity (52), a unit bit force and a unit bit torque at x = L (20)-(21), and the wall
+reaction of the string at rest (16)-(17).
+
+Enrichment adds to the basis the static response of every load beyond the tolerance
+(modal truncation augmentation; Dickens, Nakagawa & Wittbrodt 1997) and, when the
+geometric nonlinearity is on, the axial companion of each added vector: the static
+modal derivative theta = -K^-1 D^2 f_el(0)[phi, phi] (Idelsohn & Cardona 1985), the axial
+shortening and twist that a large transverse deflection phi drags along.  Without the
+companions, linear bending shapes stretch the string's axis and stiffen it: the sag of
+a 30 m string came out 40 % short.  Every added vector is M-orthogonalised against the
+basis and M-normalised.
 """
 
 from __future__ import annotations
 
+import dolfinx.fem.petsc as fem_petsc
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+import ufl
+from dolfinx import fem
 
+from fenics_drill.forms import energies
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.operators import LinearOperators
 
 
-def bit_load_responses(disc: BeamDiscretization, operators: LinearOperators) -> np.ndarray:
-    """K^-1 of a unit axial force and a unit torque at x = L, supports and drive end fixed: (ndofs, 2)."""
-    fixed = np.union1d(disc.support_dofs, [disc.end_dof(U, 0), disc.end_dof(THETA_X, 0)])
-    free = np.setdiff1d(np.arange(disc.ndofs), fixed)
-    K = sp.csc_matrix(operators.stiffness[free][:, free])
-    loads = np.zeros((disc.ndofs, 2))
-    loads[disc.end_dof(U, 1), 0] = 1.0
-    loads[disc.end_dof(THETA_X, 1), 1] = 1.0
-    responses = np.zeros_like(loads)
-    responses[free] = spla.splu(K).solve(loads[free])
-    return responses
+class StaticSolver:
+    """K^-1 with the supports and the drive end u(0), theta_x(0) held (one sparse LU, reused)."""
+
+    def __init__(self, disc: BeamDiscretization, operators: LinearOperators):
+        fixed = np.union1d(disc.support_dofs, [disc.end_dof(U, 0), disc.end_dof(THETA_X, 0)])
+        self.free = np.setdiff1d(np.arange(disc.ndofs), fixed)
+        self.ndofs = disc.ndofs
+        self.lu = spla.splu(sp.csc_matrix(operators.stiffness[self.free][:, self.free]))
+
+    def responses(self, loads: np.ndarray) -> np.ndarray:
+        """Static responses (ndofs, k) to the columns of ``loads`` (ndofs, k)."""
+        loads = np.asarray(loads).reshape(self.ndofs, -1)
+        out = np.zeros_like(loads, dtype=float)
+        out[self.free] = self.lu.solve(np.ascontiguousarray(loads[self.free]))
+        return out
 
 
-def augment(phi: np.ndarray, vectors: np.ndarray, mass: sp.spmatrix) -> np.ndarray:
-    """[Phi, V'] with V' the part of ``vectors`` M-orthogonal to [Phi], M-normalised (Gram-Schmidt twice)."""
+def bit_loads(disc: BeamDiscretization) -> dict[str, np.ndarray]:
+    """A unit axial force and a unit torque at the bit, x = L."""
+    force, torque = np.zeros(disc.ndofs), np.zeros(disc.ndofs)
+    force[disc.end_dof(U, 1)] = 1.0
+    torque[disc.end_dof(THETA_X, 1)] = 1.0
+    return {"bit_force": force, "bit_torque": torque}
+
+
+def wall_rest_load(disc: BeamDiscretization, gravity: np.ndarray, gravity_response: np.ndarray,
+                   gap: float) -> np.ndarray | None:
+    """The wall's reaction on a string at rest, estimated from the linear sag: the vertices the sag
+    takes beyond the gap rest on the wall, which carries their weight.  None if none do."""
+    from fenics_drill.model.discretization import V, W
+
+    w_dofs, v_dofs = disc.vertex_dofs(W), disc.vertex_dofs(V)
+    radius = np.hypot(gravity_response[v_dofs], gravity_response[w_dofs])
+    resting = radius > gap
+    if not resting.any():
+        return None
+    load = np.zeros(disc.ndofs)
+    load[w_dofs[resting]] = -gravity[w_dofs[resting]]
+    return load
+
+
+def scene_loads(scene, disc: BeamDiscretization, operators: LinearOperators, statics: StaticSolver):
+    """name -> full-space load vector of every load the scene applies (see the module doc)."""
+    loads: dict[str, np.ndarray] = {}
+    if scene.model.gravity and np.any(operators.gravity):
+        loads["gravity"] = operators.gravity
+    if scene.model.bit_rock:
+        loads.update(bit_loads(disc))
+    if scene.model.contact and "gravity" in loads:
+        gap = scene.borehole.radius - scene.beam.outer_radius
+        wall = wall_rest_load(disc, operators.gravity, statics.responses(operators.gravity)[:, 0], gap)
+        if wall is not None:
+            loads["wall_at_rest"] = wall
+    return loads
+
+
+def basis_error(phi: np.ndarray, stiffness, constraints: np.ndarray, load: np.ndarray, response: np.ndarray) -> float:
+    """Share of the static strain energy of ``load`` the basis ``phi`` misses (square root; 0 = exact)."""
+    exact = float(load @ response)
+    if exact <= 0:
+        return 0.0
+    K = phi.T @ (stiffness @ phi)
+    B = constraints
+    m = B.shape[0]
+    scale = np.abs(np.diag(K)).max()
+    system = np.block([[K, scale * B.T], [scale * B, np.zeros((m, m))]])
+    rhs = np.concatenate([phi.T @ load, np.zeros(m)])
+    q = np.linalg.lstsq(system, rhs, rcond=None)[0][: phi.shape[1]]
+    captured = float(load @ (phi @ q))
+    return float(np.sqrt(max(1.0 - captured / exact, 0.0)))
+
+
+def missed_share(phi: np.ndarray, stiffness, constraints: np.ndarray, vector: np.ndarray) -> float:
+    """Share of a displacement ``vector`` (held at the drive end) the basis misses: :func:`basis_error` of
+    the load K v whose static response it is."""
+    return basis_error(phi, stiffness, constraints, stiffness @ vector, vector)
+
+
+def axial_companions(disc: BeamDiscretization, statics: StaticSolver, vectors: np.ndarray,
+                     kinematics: str) -> np.ndarray:
+    """theta_i = -K^-1 D^2 f_el(0)[phi_i, phi_i] for each column phi_i (static modal derivatives)."""
+    p = disc.properties
+    dx = ufl.Measure("dx", domain=disc.mesh, metadata={"quadrature_degree": 2 * disc.element_degree})
+    zero, direction = fem.Function(disc.V), fem.Function(disc.V)
+    force = energies.elastic_force(p, ufl.TestFunction(disc.V), zero, dx, True, kinematics)
+    second = fem.form(ufl.derivative(ufl.derivative(force, zero, direction), zero, direction))
+    loads = np.zeros((disc.ndofs, vectors.shape[1]))
+    for i, phi in enumerate(vectors.T):
+        direction.x.array[:] = phi
+        loads[:, i] = -fem_petsc.assemble_vector(second).array
+    return statics.responses(loads)
+
+
+def augment(phi: np.ndarray, vectors: np.ndarray, mass: sp.spmatrix, tolerance: float = 1e-8) -> np.ndarray:
+    """[Phi, V'] with V' the part of ``vectors`` M-orthogonal to [Phi], M-normalised (Gram-Schmidt twice);
+    a vector already in the span (what is left is below ``tolerance`` of it) is dropped."""
     basis = phi
-    for v in vectors.T:
+    for v in np.asarray(vectors).reshape(phi.shape[0], -1).T:
+        size = np.sqrt(v @ (mass @ v))
+        if size == 0:
+            continue
         for _ in range(2):
             v = v - basis @ (basis.T @ (mass @ v))
-        basis = np.column_stack([basis, v / np.sqrt(v @ (mass @ v))])
+        left = np.sqrt(v @ (mass @ v))
+        if left > tolerance * size:
+            basis = np.column_stack([basis, v / left])
     return basis
+
+
+def enrich(phi: np.ndarray, scene, disc: BeamDiscretization, operators: LinearOperators,
+           constraints_of) -> tuple[np.ndarray, dict]:
+    """The guarded basis.  Checked: the static response of every load, and, with the geometric
+    nonlinearity on, its axial companion; each one the modes miss beyond ``reduction.guard_tolerance`` is
+    added when ``reduction.enrich`` is on.  ``constraints_of(phi)`` gives [B] of a basis.  Returns the
+    basis and the guard's report: per vector, the share the modes alone miss, the share the final
+    basis misses, and whether it was added."""
+    red = scene.reduction
+    statics = StaticSolver(disc, operators)
+    loads = scene_loads(scene, disc, operators, statics)
+    names = list(loads)
+    vectors = statics.responses(np.column_stack([loads[n] for n in names])) if names else np.zeros((disc.ndofs, 0))
+    if scene.model.geometric_nonlinearity and names:
+        vectors = np.column_stack([vectors, axial_companions(disc, statics, vectors, scene.model.kinematics)])
+        names += [f"{name}_axial_companion" for name in names]
+    def missed(basis, i):
+        return missed_share(basis, operators.stiffness, constraints_of(basis), vectors[:, i])
+
+    report = {name: {"error_modes": missed(phi, i)} for i, name in enumerate(names)}
+    added = [i for i, name in enumerate(names) if red.enrich and report[name]["error_modes"] > red.guard_tolerance]
+    # a companion is the second-order partner of its load's response: without the response itself in the
+    # basis, the deflection is carried by modes whose quadratic strains the companion does not cancel
+    parents = [names.index(names[i].removesuffix("_axial_companion")) for i in added if names[i].endswith("_companion")]
+    added = sorted(set(added) | set(parents))
+    if added:
+        phi = augment(phi, vectors[:, added], operators.mass)
+    for i, name in enumerate(names):
+        report[name]["added"] = i in added
+        report[name]["error"] = missed(phi, i)
+    return phi, report

@@ -19,8 +19,8 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from fenics_drill.model.discretization import BeamDiscretization
-from fenics_drill.model.enrichment import augment, bit_load_responses
+from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
+from fenics_drill.model.enrichment import enrich
 from fenics_drill.model.modes import ModalBasis, select_modes, solve_modes
 from fenics_drill.model.operators import LinearOperators
 
@@ -130,16 +130,27 @@ def weighted_product(rows_a, weights: np.ndarray, rows_b):
     return rows_a.T @ (weights[:, None] * rows_b)
 
 
+class BasisError(ValueError):
+    """A reduced basis that misses a load beyond the guard's tolerance, with enrichment off."""
+
+
 def solution_space(scene, disc: BeamDiscretization, operators: LinearOperators):
-    """(space, kept modes, all modes): the modal basis of the scene's reduction rule (Section 6.3),
-    with the static correction for the bit loads if asked, or the full space for 'none'; all
-    modes of the band B (for spectra) either way."""
+    """(space, kept modes, all modes, guard report): the modal basis of the scene's reduction rule
+    (Section 6.3) checked and enriched by the guard (:mod:`fenics_drill.model.enrichment`), or the
+    full space for 'none'; all modes of the band B (for spectra) either way."""
     p = disc.properties
     modes = solve_modes(disc, scene.modal.f_star_max, operators.mass)
     if scene.reduction.rule == "none":
-        return FullSpace(disc.ndofs, disc.support_dofs), None, modes
+        return FullSpace(disc.ndofs, disc.support_dofs), None, modes, {}
     basis = modes.select(select_modes(modes, scene.reduction, p.length, p.longitudinal_wave_speed))
-    phi = basis.vectors
-    if scene.reduction.static_correction:
-        phi = augment(phi, bit_load_responses(disc, operators), operators.mass)
-    return ModalSpace(phi), basis, modes
+    drive = [disc.end_dof(U, 0), disc.end_dof(THETA_X, 0)]
+    phi, guard = enrich(basis.vectors, scene, disc, operators, lambda phi: phi[drive])
+    tolerance = scene.reduction.guard_tolerance
+    for load, verdict in guard.items():
+        if verdict["error"] > tolerance:
+            raise BasisError(
+                f"the reduced basis (reduction.rule = '{scene.reduction.rule}') misses {verdict['error']:.3g} of the "
+                f"static response to {load.replace('_', ' ')} (reduction.guard_tolerance = {tolerance:g}): set "
+                "reduction.enrich = true to add it, widen the band (reduction.rule = 'band'), or use the full "
+                "order (reduction.rule = 'none')")
+    return ModalSpace(phi), basis, modes, guard

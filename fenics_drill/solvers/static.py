@@ -45,14 +45,17 @@ class StaticEquilibrium:
     residual: float  # relative
 
 
-def solve_static(model: DrillstringModel, tolerance: float = 1e-8, max_iterations: int = 200) -> StaticEquilibrium:
+def solve_static(model: DrillstringModel, tolerance: float = 1e-8, max_iterations: int = 200,
+                 initial: np.ndarray | None = None) -> StaticEquilibrium:
     """Equilibrium of the string at rest (velocities zero, so no friction and no bit-rock force).
 
-    With wall contact, the wall springs are stiffened stage by stage (:data:`STIFFNESS_STAGES`)
-    on copies of the model; the model itself is left as it was."""
-    q, mu = np.zeros(model.size), np.zeros(2)
+    From the straight string with wall contact, the wall springs are stiffened stage by stage
+    (:data:`STIFFNESS_STAGES`) on copies of the model; the model itself is left as it was.  From an
+    ``initial`` guess near the equilibrium (the full-order state projected on a reduced basis), one
+    Newton solve with the real wall."""
+    q, mu = (np.zeros(model.size) if initial is None else initial), np.zeros(2)
     wall = model.force("wall")
-    if wall is None:
+    if wall is None or initial is not None:
         return _newton(model, q, mu, tolerance, max_iterations)
     iterations = 0
     for factor in STIFFNESS_STAGES:

@@ -8,22 +8,20 @@ from pathlib import Path
 from fenics_drill.forms import FIELD_NAMES
 from fenics_drill.io.files import write_json
 from fenics_drill.model.discretization import BeamDiscretization
-from fenics_drill.model.modes import ModalBasis, family_counts, select_modes, solve_modes
+from fenics_drill.model.modes import family_counts, select_modes
+from fenics_drill.model.operators import assemble_linear
+from fenics_drill.model.spaces import solution_space
 from fenics_drill.studies.lifecycle import command_output
 
 
-def scene_modes(scene) -> tuple[BeamDiscretization, ModalBasis, list[int]]:
-    """Discretization, all modes in the band of analysis, and the indices the reduction keeps."""
-    disc = BeamDiscretization.from_scene(scene)
-    basis = solve_modes(disc, scene.modal.f_star_max)
-    p = disc.properties
-    kept = select_modes(basis, scene.reduction, p.length, p.longitudinal_wave_speed)
-    return disc, basis, [int(i) for i in kept]
-
-
 def modal_report(scene) -> dict:
-    """full_dofs, every mode (frequency_hz, f_star, kind, energy fractions) and the reduced basis."""
-    disc, basis, kept = scene_modes(scene)
+    """full_dofs, every mode (frequency_hz, f_star, kind, energy fractions), the reduced basis (the modes
+    the rule keeps, Table 4, and the vectors the guard adds) and the guard's report."""
+    disc = BeamDiscretization.from_scene(scene)
+    operators = assemble_linear(disc)
+    space, _, basis, guard = solution_space(scene, disc, operators)
+    p = disc.properties
+    kept = [int(i) for i in select_modes(basis, scene.reduction, p.length, p.longitudinal_wave_speed)]
     modes = [
         {
             "frequency_hz": float(f),
@@ -38,6 +36,9 @@ def modal_report(scene) -> dict:
         "size": len(kept),
         "counts": family_counts(basis.kinds[i] for i in kept),
         "mode_indices": kept,
+        "enrichment_vectors": space.size - len(kept),
+        "unknowns": space.size,
+        "guard": guard,
     }
     if scene.reduction.rule == "none":  # full order: the FE space itself, no modal basis
         reduced = {"rule": "none", "size": disc.ndofs, "counts": None, "mode_indices": None}

@@ -17,6 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from fenics_drill.model.drillstring import DrillstringModel, build_model
+from fenics_drill.model.enrichment import missed_share
+from fenics_drill.model.spaces import ModalSpace
 from fenics_drill.observables.drilling_quantities import drilling_quantities
 from fenics_drill.observables.step_rows import StepRows
 from fenics_drill.solvers.static import StaticEquilibrium, solve_static, static_report
@@ -39,13 +41,37 @@ class PreparedScene:
 
 
 def prepare(scene) -> PreparedScene:
-    """Build the model and solve its static equilibrium (raises StaticFailure)."""
+    """Build the model and solve its static equilibrium (raises StaticFailure).
+
+    A reduced model whose basis misses the string's state at rest beyond ``reduction.guard_tolerance``
+    (a heavy string on the wall, a long one sagging far: large deflections that the modes and their
+    companions carry only approximately) gets that state, solved once in the full order, as one more
+    basis vector when ``reduction.enrich`` is on; the guard's report says so (``static_state``)."""
     clock = time.perf_counter()
     model = build_model(scene)
+    initial = None
+    if isinstance(model.space, ModalSpace) and scene.reduction.enrich and scene.model.gravity:
+        model, state = _with_static_state(model, scene.reduction.guard_tolerance)
+        initial = model.space.phi.T @ (model.operators.mass @ state)  # M-orthonormal basis: the projection
     setup = time.perf_counter() - clock
-    equilibrium = solve_static(model)
+    equilibrium = solve_static(model, initial=initial)
     static = {k: v for k, v in static_report(model, equilibrium).items() if k != "contact_vertices"}
     return PreparedScene(model, equilibrium, static, setup)
+
+
+def _with_static_state(model: DrillstringModel, tolerance: float) -> tuple[DrillstringModel, np.ndarray]:
+    """The model, with the full-order static state added to its basis if the basis misses it; and that
+    state (full-space dofs)."""
+    full = model.full_order()
+    state = full.space.expand(solve_static(full).q)
+    stiffness, drive = model.operators.stiffness, model.constraints
+    missed = missed_share(model.space.phi, stiffness, drive, state)
+    guard = {**model.guard, "static_state": {"error_modes": missed, "added": missed > tolerance}}
+    if missed > tolerance:
+        model = model.with_vectors(state[:, None], guard)
+    guard["static_state"]["error"] = missed_share(model.space.phi, stiffness, model.constraints, state)
+    model.guard = guard
+    return model, state
 
 
 class RealisationRecorder:

@@ -41,10 +41,11 @@ def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
     """Static equilibrium of the scene (Section 6.4): DIR/static.json, DIR/static.xdmf, DIR/summary.json."""
     out = Path(out)
     with command_output(out, "static", scene, overwrite) as summary:
-        model = build_model(scene)
-        equilibrium = solve_static(model)
+        prepared = prepare(scene)
+        model, equilibrium = prepared.model, prepared.equilibrium
         report = static_report(model, equilibrium)
         report["reduced_size"] = model.size
+        report["basis_guard"] = model.guard
         writer = FieldWriter(model.disc, out / "static.xdmf")
         writer.write(model.space.expand(equilibrium.q), 0.0)
         writer.close()
@@ -140,6 +141,7 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
             prepared = prepare(scene)
             model, equilibrium = prepared.model, prepared.equilibrium
             summary["reduced_size"], summary["full_dofs"] = model.size, model.disc.ndofs
+            summary["basis_guard"] = model.guard
             summary["setup_time_s"], summary["static"] = prepared.setup_time_s, prepared.static
             simulation = Simulation(model, scene)
             start = simulation.initial_state(equilibrium.q, equilibrium.mu)
