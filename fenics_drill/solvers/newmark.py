@@ -58,8 +58,11 @@ class NewmarkNewton:
         return h0 + self.model.drive_rate * t
 
     @staticmethod
-    def _scale(ev: Evaluation, mu_force: np.ndarray) -> float:
-        return max(np.linalg.norm(ev.internal), np.linalg.norm(ev.external), np.linalg.norm(mu_force), 1e-30)
+    def _scale(ev: Evaluation, mu_force: np.ndarray, inertia: np.ndarray) -> float:
+        """The size of the forces that balance at a state: internal, external, constraint and inertia
+        (M qdd, so that a free vibration, where M qdd + K q cancel, still has a scale)."""
+        return max(np.linalg.norm(ev.internal), np.linalg.norm(ev.external), np.linalg.norm(mu_force),
+                   np.linalg.norm(inertia), 1e-30)
 
     def initial_acceleration(self, q, qd, mu_guess) -> tuple[np.ndarray, np.ndarray]:
         """qdd(0) and mu(0) from (65) and the twice-differentiated constraint (h'' = 0)."""
@@ -100,12 +103,14 @@ class NewmarkNewton:
         def check(iteration, q, mu, ev, norm, gap):
             if not np.isfinite(norm):
                 raise NewtonFailure(f"Newton produced non-finite values at dt = {dt:.3e} s")
-            # forces can balance to round-off (e.g. M qdd + K q in free vibration): also measure
-            # against the predictor's residual and the force level of earlier steps
-            self._force_level = max(self._force_level, self._scale(ev, self.model.constraints.T @ mu))
-            if norm <= self.tolerance * self._force_level and np.all(
+            # the residual is measured against the forces that balance at this iterate and at the states
+            # accepted before (never against a predictor's residual: an explosive predictor would make
+            # any iterate look converged)
+            scale = self._scale(ev, self.model.constraints.T @ mu, self.model.mass @ rates(q)[1])
+            if norm <= self.tolerance * max(self._force_level, scale) and np.all(
                 np.abs(gap) <= self.tolerance * np.maximum(np.abs(target), 1.0)
             ):
+                self._force_level = max(self._force_level, scale)
                 self._steps_since_tangent += 1
                 return State(state.t + dt, q, *rates(q), mu), iteration, ev
             return None
@@ -114,7 +119,6 @@ class NewmarkNewton:
         mu = state.mu.copy()
         stale = self._internal_parts is None or self._steps_since_tangent >= self.tangent_reuse
         ev = evaluate(q, mu, stale and self.model.internal.state_dependent)
-        self._force_level = max(self._force_level, np.linalg.norm(ev.residual))
         result = saddle_newton(lambda q, mu: evaluate(q, mu), self.model.space, self.model.constraints, target,
                                q, mu, ev, check, self.max_iterations)
         if result is None:

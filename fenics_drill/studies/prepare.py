@@ -21,7 +21,7 @@ from fenics_drill.model.enrichment import missed_share
 from fenics_drill.model.spaces import ModalSpace
 from fenics_drill.observables.drilling_quantities import drilling_quantities
 from fenics_drill.observables.step_rows import StepRows
-from fenics_drill.solvers.static import StaticEquilibrium, solve_static, static_report
+from fenics_drill.solvers.static import StaticEquilibrium, StaticFailure, solve_static, static_report
 from fenics_drill.solvers.step_control import StepTooSmall
 from fenics_drill.solvers.time_loop import Simulation
 
@@ -52,7 +52,8 @@ def prepare(scene) -> PreparedScene:
     initial = None
     if isinstance(model.space, ModalSpace) and scene.reduction.enrich and scene.model.gravity:
         model, state = _with_static_state(model, scene.reduction.guard_tolerance)
-        initial = model.space.phi.T @ (model.operators.mass @ state)  # M-orthonormal basis: the projection
+        if state is not None:
+            initial = model.space.phi.T @ (model.operators.mass @ state)  # M-orthonormal basis: the projection
     setup = time.perf_counter() - clock
     equilibrium = solve_static(model, initial=initial)
     static = {k: v for k, v in static_report(model, equilibrium).items() if k != "contact_vertices"}
@@ -61,9 +62,14 @@ def prepare(scene) -> PreparedScene:
 
 def _with_static_state(model: DrillstringModel, tolerance: float) -> tuple[DrillstringModel, np.ndarray]:
     """The model, with the full-order static state added to its basis if the basis misses it; and that
-    state (full-space dofs)."""
+    state (full-space dofs), or None if the full order finds no static state (said in the guard)."""
     full = model.full_order()
-    state = full.space.expand(solve_static(full).q)
+    try:
+        state = full.space.expand(solve_static(full).q)
+    except StaticFailure as failure:  # the reduced solve may still succeed: it is tried as it was
+        model.guard = {**model.guard, "static_state": {"error": None, "added": False,
+                                                       "message": f"full-order static state not found: {failure}"}}
+        return model, None
     stiffness, drive = model.operators.stiffness, model.constraints
     missed = missed_share(model.space.phi, stiffness, drive, state)
     guard = {**model.guard, "static_state": {"error_modes": missed, "added": missed > tolerance}}

@@ -284,8 +284,11 @@ def test_zero_contact_stiffness_with_contact_on_is_refused(tmp_path):
 
 
 def test_a_wall_the_string_goes_through_makes_the_run_suspect(tmp_path):
-    """k_FS1 = 1e4 N/m: each vertex carries ~190 N of weight, so the string sinks ~20 mm into a 15 mm gap."""
-    result = tool("run", PAPER, *SMALL, "--set", "contact.stiffness_linear=1e4", "--set", "contact.stiffness_cubic=0",
+    """k_FS1 = 1e5 N/m and no cubic spring: each vertex carries ~190 N of weight, so the string sinks ~2 mm
+    into the wall, more than 10 % of the 15 mm gap.  (The paper's modal basis: with so soft a wall the
+    static state is not found in the full order, docs/verification.md.)"""
+    result = tool("run", PAPER, *SMALL, "--set", "contact.stiffness_linear=1e5", "--set", "contact.stiffness_cubic=0",
+                  "--set", "reduction.enrich=false", "--set", "reduction.guard_tolerance=1",
                   "--set", "time.t_end=0.01", "--quiet", "--out", str(tmp_path))
     assert result.returncode == 0 and "SUSPECT" in result.stdout
     summary = summary_of(tmp_path)

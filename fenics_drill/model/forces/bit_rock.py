@@ -38,7 +38,8 @@ def bit_rock_torque(bit_force, bit_spin_rate, friction, borehole_radius):
 def torque_regularisation_slope(omega):
     """d xi_BR / d omega of Eq. (22)."""
     omega = np.asarray(omega, dtype=float)
-    return 1.0 / np.cosh(omega) ** 2 + 2.0 * (1.0 - omega**2) / (1.0 + omega**2) ** 2
+    # 1 - tanh^2 = 1 / cosh^2, without overflow at the large omega of a Newton trial iterate
+    return 1.0 - np.tanh(omega) ** 2 + 2.0 * (1.0 - omega**2) / (1.0 + omega**2) ** 2
 
 
 @dataclass
