@@ -167,10 +167,6 @@ def enrich(phi: np.ndarray, scene, disc: BeamDiscretization, operators: LinearOp
 
     report = {name: {"error_modes": missed(phi, i)} for i, name in enumerate(names)}
     added = [i for i, name in enumerate(names) if red.enrich and report[name]["error_modes"] > red.guard_tolerance]
-    # a companion is the second-order partner of its load's response: without the response itself in the
-    # basis, the deflection is carried by modes whose quadratic strains the companion does not cancel
-    parents = [names.index(names[i].removesuffix("_axial_companion")) for i in added if names[i].endswith("_companion")]
-    added = sorted(set(added) | set(parents))
     if added:
         phi = augment(phi, vectors[:, added], operators.mass)
     for i, name in enumerate(names):
