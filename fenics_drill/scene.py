@@ -176,6 +176,10 @@ class Reduction:
     enrich: bool = key(True, "add to the basis the static response of every load it misses beyond "
                        "reduction.guard_tolerance, with its axial companion (fenics_drill/model/enrichment.py); "
                        "false: a basis missing a load beyond the tolerance stops the command")
+    axial_companions: bool = key(False, "also check and add the axial companion (static modal derivative) of "
+                                 "each load's response: off by default, the static state carries the large "
+                                 "deflections and the companions spoil the bit dynamics (benchmarks/"
+                                 "reduced_accuracy.md)")
     guard_tolerance: float = key(0.03, "largest admissible share of a load's static response the basis may miss "
                                  "(square root of the missed strain-energy share; 0.03 = 0.1 % of the energy); 1 "
                                  "accepts any basis (the paper's pure modal basis with enrich = false)",

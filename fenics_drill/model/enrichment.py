@@ -16,12 +16,16 @@ reaction of the string at rest (16)-(17).
 
 Enrichment adds to the basis the static response of every load beyond the tolerance
 (modal truncation augmentation; Dickens, Nakagawa & Wittbrodt 1997) and, when the
-geometric nonlinearity is on, the axial companion of each added vector: the static
-modal derivative theta = -K^-1 D^2 f_el(0)[phi, phi] (Idelsohn & Cardona 1985), the axial
-shortening and twist that a large transverse deflection phi drags along.  Without the
-companions, linear bending shapes stretch the string's axis and stiffen it: the sag of
-a 30 m string came out 40 % short.  Every added vector is M-orthogonalised against the
-basis and M-normalised.
+geometric nonlinearity is on and ``reduction.axial_companions`` asks for it, the axial
+companion of each load's response: the static modal derivative theta = -K^-1 D^2
+f_el(0)[phi, phi] (Idelsohn & Cardona 1985), the axial shortening and twist that a large
+transverse deflection phi drags along.  Linear bending shapes alone stretch the string's
+axis and stiffen it (the sag of a 30 m string came out 40 % short); the companions recover
+part of it (677 of 747 mm), and the static state added by
+:func:`fenics_drill.studies.prepare.prepare` all of it.  In the dynamics of the paper scene
+the companions make the bit velocity fluctuate 60 % more than the full order
+(benchmarks/reduced_accuracy.md), so they are off by default.  Every added vector is
+M-orthogonalised against the basis and M-normalised.
 """
 
 from __future__ import annotations
@@ -149,9 +153,9 @@ def augment(phi: np.ndarray, vectors: np.ndarray, mass: sp.spmatrix, tolerance: 
 
 def enrich(phi: np.ndarray, scene, disc: BeamDiscretization, operators: LinearOperators,
            constraints_of) -> tuple[np.ndarray, dict]:
-    """The guarded basis.  Checked: the static response of every load, and, with the geometric
-    nonlinearity on, its axial companion; each one the modes miss beyond ``reduction.guard_tolerance`` is
-    added when ``reduction.enrich`` is on.  ``constraints_of(phi)`` gives [B] of a basis.  Returns the
+    """The guarded basis.  Checked: the static response of every load, and, with
+    ``reduction.axial_companions`` and the geometric nonlinearity on, its axial companion; each one the
+    modes miss beyond ``reduction.guard_tolerance`` is added when ``reduction.enrich`` is on.  ``constraints_of(phi)`` gives [B] of a basis.  Returns the
     basis and the guard's report: per vector, the share the modes alone miss, the share the final
     basis misses, and whether it was added."""
     red = scene.reduction
@@ -159,7 +163,7 @@ def enrich(phi: np.ndarray, scene, disc: BeamDiscretization, operators: LinearOp
     loads = scene_loads(scene, disc, operators, statics)
     names = list(loads)
     vectors = statics.responses(np.column_stack([loads[n] for n in names])) if names else np.zeros((disc.ndofs, 0))
-    if scene.model.geometric_nonlinearity and names:
+    if red.axial_companions and scene.model.geometric_nonlinearity and names:
         vectors = np.column_stack([vectors, axial_companions(disc, statics, vectors, scene.model.kinematics)])
         names += [f"{name}_axial_companion" for name in names]
     def missed(basis, i):
