@@ -99,6 +99,10 @@ class Contact:
     stiffness_cubic: float = _nonneg("k_FS2 of Eq. (17) [N/m^3]", 1e16)
     damping: float = _nonneg("c_FS of Eq. (17) [N s/m^4]", 1e6)
     friction: float = _nonneg("mu_FS of Eqs. (18)-(19) [-]", 0.25)
+    axial_friction_law: str = key("model", "the axial friction (18): 'consistent', 'printed', or 'model' "
+                                  "(as model.laws says)", choices=("model", "consistent", "printed"))
+    friction_torque_law: str = key("model", "the friction torque (19): 'consistent', 'printed', or 'model' "
+                                   "(as model.laws says)", choices=("model", "consistent", "printed"))
     sliding_velocity_scale: float = _pos(
         "v_s of the regularised sgn(v) = tanh(v / v_s) in (18)-(19), applied to the axial velocity "
         "and to the surface speed R_bh theta_x_dot [m/s]", 1e-3)
@@ -109,6 +113,8 @@ class BitRock:
     limit_force: float = _nonneg("Gamma_BR of Eq. (20) [N]", 30e3)
     rate: float = _nonneg("alpha_BR of Eq. (20) [s/m]", 400.0)
     friction: float = key(0.4, "mu_BR of Eq. (21) [-]", lambda x: 0 <= x <= 1, "in [0, 1]")
+    torque_law: str = key("model", "the bit torque (21): 'consistent', 'printed', or 'model' (as model.laws says)",
+                          choices=("model", "consistent", "printed"))
 
 
 @dataclass(frozen=True)
@@ -155,6 +161,10 @@ class Model:
     bit_rock: bool = key(True, "evaluate the bit-rock force and torque (20)-(22)")
     geometric_nonlinearity: bool = key(True, "assemble the geometric nonlinear force F_SE (49)")
     inertial_nonlinearity: bool = key(True, "assemble the inertial nonlinear force F_KE (48)")
+    laws: str = key("consistent", "friction (18), (19) and bit torque (21): 'consistent' (they never do positive "
+                     "work, docs/errata.md) or 'printed' (as printed: with F_n, F_BR <= 0 they inject energy); each "
+                     "law can also be set alone (contact.axial_friction_law, contact.friction_torque_law, "
+                     "bit_rock.torque_law)", choices=("consistent", "printed"))
     kinematics: str = key("objective", "cross-section kinematics of the strain energy: 'objective' (strains "
                           "unchanged by a rigid spin theta_x, docs/errata.md) or 'printed' (Eq. 14 as printed)",
                           choices=("objective", "printed"))
@@ -254,6 +264,10 @@ class Scene:
             raw.setdefault(section, {}).update(entries)
         return validate(raw)
 
+    def law(self, choice: str) -> str:
+        """'consistent' or 'printed' for a per-law switch (``contact.axial_friction_law``, ...)."""
+        return self.model.laws if choice == "model" else choice
+
     @property
     def beam_properties(self) -> BeamProperties:
         """The parameter object the forms take (gravity 0 when ``model.gravity`` is off)."""
@@ -264,6 +278,10 @@ class Scene:
             damping=b.damping, gravity=self.environment.gravity if self.model.gravity else 0.0,
         )
 
+
+#: The printed laws (18), (19), (21) are the consistent ones with mu replaced by -mu, since F_n, F_BR <= 0
+#: (docs/errata.md): the sign each choice gives mu.
+LAW_SIGN = {"consistent": 1.0, "printed": -1.0}
 
 #: section name -> its dataclass, in the order of the TOML file.
 SECTIONS: dict[str, type] = {s.name: s.default_factory for s in dataclasses.fields(Scene)}

@@ -2,9 +2,15 @@
 
 Mechanical energy E = T (24) + strain energy (30) + the potentials of the point forces
 (gravity -F_G . U, wall springs k1 delta^2 / 2 + k2 delta^4 / 4).  The drive's work is
-int lambda . h_dot dt; the dissipated energy collects the viscous damping (38) and the
-work of every non-conservative point force, each under its name (the wall damper and
-friction (17)-(19) as ``wall``, the bit-rock reaction (20)-(21) as ``bit_rock``).  Work
+int lambda . h_dot dt; the viscous damping (38) dissipates; and every non-conservative law of
+the point forces does its own work, booked under its name: ``wall_damper`` (17),
+``wall_axial_friction`` (18), ``wall_friction_torque`` (19), ``bit_rock_force`` (20),
+``bit_rock_torque`` (21).  A law that dissipates does negative work; one that injects energy
+(the printed (18), (19), (21), docs/errata.md) shows as a positive term, not as a balance error:
+
+    E(t) - E(0) = W_drive + sum_laws W_law - D_damping.
+
+Work
 increments use the trapezoidal rule  dW = (f_n + f_{n+1}) / 2 . (q_{n+1} - q_n),
 which is exact for the average-acceleration Newmark rule (alpha = 0) on linear
 terms; with alpha > 0 the budget also shows Newmark's numerical dissipation.
@@ -24,7 +30,7 @@ class PowerTerms:
     drive: np.ndarray  # lambda (force, torque applied by the drive at x = 0)
     drive_displacement: np.ndarray  # B q: (u(0), theta_x(0))
     damping: np.ndarray  # C qd
-    forces: dict[str, np.ndarray]  # dissipative part of each non-conservative point force, by name
+    laws: dict[str, np.ndarray]  # the non-conservative generalised force of each law of the point forces
 
 
 @dataclass
@@ -32,6 +38,7 @@ class EnergyBudget:
     initial_energy: float
     input_work: float = 0.0
     dissipated: dict = field(default_factory=lambda: {"damping": 0.0})
+    work_by_law: dict = field(default_factory=dict)
     energy: float = 0.0
     kinetic: float = 0.0
     strain: float = 0.0
@@ -45,8 +52,9 @@ class EnergyBudget:
         """Add the work of one step."""
         self.input_work += 0.5 * float((old.drive + new.drive) @ (new.drive_displacement - old.drive_displacement))
         self.dissipated["damping"] += 0.5 * float((old.damping + new.damping) @ dq)
-        for name, force in new.forces.items():
-            self.dissipated[name] = self.dissipated.get(name, 0.0) - 0.5 * float((old.forces[name] + force) @ dq)
+        for name in {**old.laws, **new.laws}:  # a law present at one end of the step only works from that end
+            total = sum(laws[name] for laws in (old.laws, new.laws) if name in laws)
+            self.work_by_law[name] = self.work_by_law.get(name, 0.0) + 0.5 * float(total @ dq)
 
     def record(self, kinetic: float, strain: float, potential: float) -> None:
         """Set the mechanical energy of the current state (potential: of the point forces)."""
@@ -56,7 +64,8 @@ class EnergyBudget:
 
     @property
     def total_dissipated(self) -> float:
-        return sum(self.dissipated.values())
+        """Energy taken out of the string: the damping's, minus the net work of the laws."""
+        return self.dissipated["damping"] - sum(self.work_by_law.values())
 
     @property
     def balance_error(self) -> float:
@@ -73,6 +82,8 @@ class EnergyBudget:
             "potential": self.potential,
             "energy_change": self.energy - self.initial_energy,
             "dissipated": self.total_dissipated,
-            "dissipated_by": dict(self.dissipated),
+            "dissipated_by": {"damping": self.dissipated["damping"], **{k: -w for k, w in self.work_by_law.items()}},
+            "work_by_law": dict(self.work_by_law),
+            "injected_by": {k: w for k, w in self.work_by_law.items() if w > 0},
             "balance_error": self.balance_error,
         }

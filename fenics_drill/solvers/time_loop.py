@@ -59,7 +59,7 @@ class Simulation:
             drive=-state.mu,
             drive_displacement=self.model.constraints @ state.q,
             damping=self.model.internal.damping_force(state.qd),
-            forces={f.name: ev.forces[f.name].dissipative for f in self.model.forces if not f.conservative},
+            laws={name: law for f in self.model.forces for name, law in ev.forces[f.name].laws.items()},
         )
 
     def mechanical_energy(self, state: State, ev: Evaluation) -> tuple[float, float, float]:

@@ -34,7 +34,7 @@ class TipSpring:
 
     def evaluate(self, q, qd, with_tangent=False):
         u = self.row @ q
-        return ForceEvaluation(self.row.T @ (-self.k * u), np.zeros_like(q), 0.5 * self.k * float(u @ u))
+        return ForceEvaluation(self.row.T @ (-self.k * u), 0.5 * self.k * float(u @ u), {})
 
     def tangent(self, evaluation, c_u, c_v):
         return weighted_product(self.row, np.array([-c_u * self.k]), self.row)

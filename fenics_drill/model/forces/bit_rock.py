@@ -16,6 +16,7 @@ import numpy as np
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
 from fenics_drill.model.spaces import weighted_product
+from fenics_drill.scene import LAW_SIGN
 
 
 def bit_rock_force(bit_velocity, limit_force, rate):
@@ -44,7 +45,7 @@ def torque_regularisation_slope(omega):
 
 @dataclass
 class BitForces(ForceEvaluation):
-    """The bit's state and reaction; ``generalised`` is [Phi]^T of (51), all of it dissipative."""
+    """The bit's state and reaction; ``generalised`` is [Phi]^T of (51), none of it conservative."""
 
     bit_velocity: float = 0.0
     bit_spin_rate: float = 0.0
@@ -66,21 +67,24 @@ class BitRock:
         "bit_torque": ("N m", "bit-rock torque T_BR, Eq. (21)"),
     }
 
-    def __init__(self, disc: BeamDiscretization, space, bit_rock, borehole_radius: float):
-        """``bit_rock``: the scene's [bit_rock] section (or a realisation of it)."""
+    def __init__(self, disc: BeamDiscretization, space, bit_rock, borehole_radius: float, torque_sign: float = 1.0):
+        """``bit_rock``: the scene's [bit_rock] section (or a realisation of it); ``torque_sign``: +1 for the
+        consistent torque (21), -1 for the torque as printed (mu_BR -> -mu_BR, since F_BR <= 0)."""
+        self.torque_sign = torque_sign
         self.row_u = space.rows([disc.end_dof(U, 1)])  # 1 x N_red: q -> u(L)
         self.row_tx = space.rows([disc.end_dof(THETA_X, 1)])  # 1 x N_red: q -> theta_x(L)
         self.limit_force, self.rate = bit_rock.limit_force, bit_rock.rate
-        self.friction, self.borehole_radius = bit_rock.friction, borehole_radius
+        self.friction, self.borehole_radius = torque_sign * bit_rock.friction, borehole_radius
 
     @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "BitRock":
-        return cls(disc, space, scene.bit_rock, scene.borehole.radius)
+        return cls(disc, space, scene.bit_rock, scene.borehole.radius, LAW_SIGN[scene.law(scene.bit_rock.torque_law)])
 
     def with_parameters(self, bit_rock) -> "BitRock":
         """A copy with other law parameters (a Monte Carlo realisation of [bit_rock])."""
         changed = copy.copy(self)
-        changed.limit_force, changed.rate, changed.friction = bit_rock.limit_force, bit_rock.rate, bit_rock.friction
+        changed.limit_force, changed.rate = bit_rock.limit_force, bit_rock.rate
+        changed.friction = self.torque_sign * bit_rock.friction
         return changed
 
     def record(self, forces: "BitForces") -> dict[str, float]:
@@ -96,7 +100,8 @@ class BitRock:
         d_torque_velocity = self.friction * self.borehole_radius * xi * d_force
         d_torque_spin = self.friction * force * self.borehole_radius * float(torque_regularisation_slope(omega))
         generalised = self.row_u.T @ np.array([force]) + self.row_tx.T @ np.array([torque])
-        return BitForces(generalised, generalised, 0.0, u_dot, omega, force, torque, d_force, d_torque_velocity,
+        laws = {"bit_rock_force": self.row_u.T @ np.array([force]), "bit_rock_torque": self.row_tx.T @ np.array([torque])}
+        return BitForces(generalised, 0.0, laws, u_dot, omega, force, torque, d_force, d_torque_velocity,
                          d_torque_spin)
 
     def tangent(self, forces: BitForces, c_u: float, c_v: float):

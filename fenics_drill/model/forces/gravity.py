@@ -19,14 +19,13 @@ class Gravity:
 
     def __init__(self, load: np.ndarray):
         self.load = load  # [Phi]^T F_G
-        self._zero = np.zeros_like(load)
 
     @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "Gravity":
         return cls(space.project(operators.gravity))
 
     def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> ForceEvaluation:
-        return ForceEvaluation(self.load, self._zero, -float(self.load @ q))
+        return ForceEvaluation(self.load, -float(self.load @ q), {})
 
     def tangent(self, evaluation: ForceEvaluation, c_u: float, c_v: float):
         return None

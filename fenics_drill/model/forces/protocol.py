@@ -2,8 +2,8 @@
 
 A force is built from a scene (:meth:`PointForce.from_scene`), evaluated at a state
 (q, qd) into a :class:`ForceEvaluation`, and differentiated for Newton.  The model
-sums the generalised forces, the energy budget books each non-conservative force's
-work under its ``name`` and each force's potential, and the time-series recorder asks
+sums the generalised forces, the energy budget books the work of each non-conservative
+law under its name and each force's potential, and the time-series recorder asks
 each force for its per-step quantities.  A pointwise law lives in the module of its
 force, beside its derivative.
 """
@@ -21,8 +21,10 @@ class ForceEvaluation:
     """What every force returns at one state (law-specific fields in subclasses)."""
 
     generalised: np.ndarray  # [Phi]^T f: the generalised force on the reduced unknowns
-    dissipative: np.ndarray  # the part whose work the energy budget books as dissipated (zero if conservative)
     potential: float  # stored energy of the conservative part [J]
+    #: the non-conservative part of ``generalised``, law by law (the energy budget books the work of each
+    #: under its name: negative for a law that dissipates, positive for one that injects energy)
+    laws: dict[str, np.ndarray]
 
 
 class PointForce(Protocol):

@@ -24,6 +24,7 @@ from fenics_drill.model.discretization import W as W_FIELD
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
 from fenics_drill.model.spaces import weighted_product
+from fenics_drill.scene import LAW_SIGN
 
 
 def indentation(v, w, gap):
@@ -48,14 +49,18 @@ def regularised_sign(x, velocity_scale):
     return np.tanh(np.asarray(x, dtype=float) / velocity_scale)
 
 
-def wall_friction(normal_force, axial_velocity, spin_rate, friction, borehole_radius, velocity_scale):
+def wall_friction(normal_force, axial_velocity, spin_rate, friction, borehole_radius, velocity_scale,
+                  torque_friction=None):
     """Axial friction force (18) and friction torque (19) with the magnitude |F_n|:
-    F_a = -mu |F_n| sgn(u_dot), T = -mu |F_n| R_bh sgn(theta_x_dot).
+    F_a = -mu |F_n| sgn(u_dot), T = -mu_T |F_n| R_bh sgn(theta_x_dot) (mu_T = ``torque_friction``, mu if None).
 
-    Both signs are regularised on a sliding speed: u_dot and R_bh theta_x_dot."""
-    magnitude = friction * np.abs(normal_force)
-    force = -magnitude * regularised_sign(axial_velocity, velocity_scale)
-    torque = -magnitude * borehole_radius * regularised_sign(borehole_radius * np.asarray(spin_rate), velocity_scale)
+    Both signs are regularised on a sliding speed: u_dot and R_bh theta_x_dot.  As printed, (18) and
+    (19) read -mu F_n sgn with F_n <= 0: the same laws with mu -> -mu, which push along the motion."""
+    torque_friction = friction if torque_friction is None else torque_friction
+    magnitude = np.abs(normal_force)
+    force = -friction * magnitude * regularised_sign(axial_velocity, velocity_scale)
+    torque = -torque_friction * magnitude * borehole_radius * regularised_sign(
+        borehole_radius * np.asarray(spin_rate), velocity_scale)
     return force, torque
 
 
@@ -63,9 +68,9 @@ def wall_friction(normal_force, axial_velocity, spin_rate, friction, borehole_ra
 class WallForces(ForceEvaluation):
     """Nodal state and forces of one evaluation (arrays over the vertices).
 
-    ``generalised`` is [Phi]^T of (50); ``dissipative`` the same without the elastic springs
-    -k1 delta - k2 delta^3; ``potential`` the sum of k1 delta^2 / 2 + k2 delta^4 / 4 over the
-    vertices in contact."""
+    ``generalised`` is [Phi]^T of (50); ``laws`` splits its non-conservative part into the damper of
+    (17), the axial friction (18) and the friction torque (19); ``potential`` is the sum of
+    k1 delta^2 / 2 + k2 delta^4 / 4 over the vertices in contact."""
 
     indentation: np.ndarray = None
     in_contact: np.ndarray = None
@@ -85,19 +90,26 @@ class WallContact:
         "vertices_in_contact": ("1", "vertices in contact with the wall at the end of the step"),
     }
 
-    def __init__(self, disc: BeamDiscretization, space, contact, borehole_radius: float):
-        """``contact``: the scene's [contact] section."""
+    def __init__(self, disc: BeamDiscretization, space, contact, borehole_radius: float,
+                 law_sign: tuple[float, float] = (1.0, 1.0)):
+        """``contact``: the scene's [contact] section; ``law_sign``: +1 (consistent) or -1 (as printed) for
+        the axial friction (18) and the friction torque (19)."""
         self.x = disc.vertex_x
         self.gap = borehole_radius - disc.properties.outer_radius
         self.borehole_radius = borehole_radius
         self.k1, self.k2 = contact.stiffness_linear, contact.stiffness_cubic
-        self.c, self.mu = contact.damping, contact.friction
+        self.c = contact.damping
+        # the friction coefficient of each law, negative for a law taken as printed (scene.LAW_SIGN)
+        self.mu_axial = law_sign[0] * contact.friction
+        self.mu_torque = law_sign[1] * contact.friction
         self.v_s = contact.sliding_velocity_scale
         self.rows = {f: space.rows(disc.vertex_dofs(f)) for f in (U_FIELD, V_FIELD, W_FIELD, TX_FIELD)}
 
     @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "WallContact":
-        return cls(disc, space, scene.contact, scene.borehole.radius)
+        signs = (LAW_SIGN[scene.law(scene.contact.axial_friction_law)],
+                 LAW_SIGN[scene.law(scene.contact.friction_torque_law)])
+        return cls(disc, space, scene.contact, scene.borehole.radius, signs)
 
     def with_stiffness_scale(self, factor: float) -> "WallContact":
         """A copy whose wall springs k_FS1, k_FS2 are scaled by ``factor`` (the static continuation)."""
@@ -120,7 +132,8 @@ class WallContact:
         zero = np.zeros_like(q)
         if active.size == 0:
             empty = np.zeros(0)
-            return WallForces(zero, zero, 0.0, delta, delta > 0, empty, empty, empty, {} if with_tangent else None)
+            laws = dict.fromkeys(("wall_damper", "wall_axial_friction", "wall_friction_torque"), zero)
+            return WallForces(zero, 0.0, laws, delta, delta > 0, empty, empty, empty, {} if with_tangent else None)
         rows = {f: r[f][active] for f in r}
         va, wa = v[active], w[active]
         dv, dw = rows[V_FIELD] @ qd, rows[W_FIELD] @ qd
@@ -130,15 +143,17 @@ class WallContact:
         d = delta[active]
         d_rate = n_v * dv + n_w * dw
         normal = hunt_crossley_normal_force(d, d_rate, self.k1, self.k2, self.c)
-        axial, torque = wall_friction(normal, du, dtx, self.mu, self.borehole_radius, self.v_s)
+        axial, torque = wall_friction(normal, du, dtx, self.mu_axial, self.borehole_radius, self.v_s, self.mu_torque)
         elastic = -self.k1 * d - self.k2 * d**3
         generalised = (
             rows[U_FIELD].T @ axial + rows[V_FIELD].T @ (normal * n_v)
             + rows[W_FIELD].T @ (normal * n_w) + rows[TX_FIELD].T @ torque
         )
-        dissipative = generalised - rows[V_FIELD].T @ (elastic * n_v) - rows[W_FIELD].T @ (elastic * n_w)
+        damper = normal - elastic  # the Hunt-Crossley damper, with the clip that keeps the wall from pulling
+        laws = {"wall_damper": rows[V_FIELD].T @ (damper * n_v) + rows[W_FIELD].T @ (damper * n_w),
+                "wall_axial_friction": rows[U_FIELD].T @ axial, "wall_friction_torque": rows[TX_FIELD].T @ torque}
         potential = float(np.sum(0.5 * self.k1 * d**2 + 0.25 * self.k2 * d**4))
-        out = WallForces(generalised, dissipative, potential, delta, delta > 0, normal, axial, torque)
+        out = WallForces(generalised, potential, laws, delta, delta > 0, normal, axial, torque)
         if with_tangent:
             out.derivatives = self._derivatives(rows, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal)
         return out
@@ -152,11 +167,11 @@ class WallContact:
         dFn_dv = spring * n_v + damper * (dv - d_rate * n_v) / radius
         dFn_dw = spring * n_w + damper * (dw - d_rate * n_w) / radius
         dFn_ddv, dFn_ddw = damper * n_v, damper * n_w
-        R, mu = self.borehole_radius, self.mu
+        R, mu_a, mu_t = self.borehole_radius, self.mu_axial, self.mu_torque
         s_a = regularised_sign(du, self.v_s)
         s_t = regularised_sign(R * dtx, self.v_s)
         # F_a = mu F_n s_a and T = mu R F_n s_t since |F_n| = -F_n
-        fa, ft = mu * s_a, mu * R * s_t
+        fa, ft = mu_a * s_a, mu_t * R * s_t
         curv = normal / radius
         U, V, W, TX = U_FIELD, V_FIELD, W_FIELD, TX_FIELD
         position = {  # (output field, input field): d F_out / d y_in
@@ -167,8 +182,8 @@ class WallContact:
         velocity = {
             (V, V): dFn_ddv * n_v, (V, W): dFn_ddw * n_v, (W, V): dFn_ddv * n_w, (W, W): dFn_ddw * n_w,
             (U, V): fa * dFn_ddv, (U, W): fa * dFn_ddw, (TX, V): ft * dFn_ddv, (TX, W): ft * dFn_ddw,
-            (U, U): mu * normal * (1 - s_a**2) / self.v_s,
-            (TX, TX): mu * R * normal * (1 - s_t**2) * R / self.v_s,
+            (U, U): mu_a * normal * (1 - s_a**2) / self.v_s,
+            (TX, TX): mu_t * R * normal * (1 - s_t**2) * R / self.v_s,
         }
         return {"rows": rows, "position": position, "velocity": velocity}
 
