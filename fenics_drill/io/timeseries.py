@@ -30,14 +30,15 @@ class TimeSeriesWriter:
     loses only the rows since the last write."""
 
     def __init__(self, path: str | Path, vertex_x: np.ndarray, attributes: dict, modes=None,
-                 clock: FlushClock | None = None):
+                 clock: FlushClock | None = None, held_modes=None):
+        """``modes``: the band B of the free string; ``held_modes``: of the string held by the drive."""
         self.path = Path(path)
         self.clock = clock or FlushClock()
         self.buffer: dict[str, list] = {name: [] for name in VARIABLES}
-        write_atomic(self.path, lambda tmp: self._create(tmp, vertex_x, attributes, modes))
+        write_atomic(self.path, lambda tmp: self._create(tmp, vertex_x, attributes, modes, held_modes))
 
     @staticmethod
-    def _create(path: Path, vertex_x: np.ndarray, attributes: dict, modes) -> None:
+    def _create(path: Path, vertex_x: np.ndarray, attributes: dict, modes, held_modes) -> None:
         with h5py.File(path, "w") as f:
             for key, value in attributes.items():
                 f.attrs[key] = value
@@ -54,12 +55,15 @@ class TimeSeriesWriter:
             counts = f.create_dataset("impacts_per_vertex", data=np.zeros(len(vertex_x)))
             counts.attrs["units"], counts.attrs["long_name"] = "1", "wall impacts (contact onsets) per vertex"
             counts.dims[0].attach_scale(x)
-            if modes is not None:
-                group = f.create_group("modes")
-                group["frequency"] = modes.frequencies_hz
-                group["frequency"].attrs["units"] = "Hz"
-                group["frequency"].attrs["long_name"] = "natural frequencies of the band B (Eq. 62)"
-                group["kind"] = np.array(modes.kinds, dtype="S")
+            for name, basis, what in (("modes", modes, "natural frequencies of the band B (Eq. 62)"),
+                                      ("modes_drive_held", held_modes, "natural frequencies of the band B with "
+                                       "u and theta_x held at x = 0, as the drive holds them in a run")):
+                if basis is not None:
+                    group = f.create_group(name)
+                    group["frequency"] = basis.frequencies_hz
+                    group["frequency"].attrs["units"] = "Hz"
+                    group["frequency"].attrs["long_name"] = what
+                    group["kind"] = np.array(basis.kinds, dtype="S")
 
     def append(self, row: dict) -> bool:
         """Buffer one row; write the buffer when the clock says so.  True if it was written."""
@@ -108,10 +112,13 @@ def read_series(path: str | Path) -> tuple[dict, dict]:
     return data, attrs
 
 
-def read_modes(path: str | Path) -> tuple[np.ndarray, list[str]]:
-    """(natural frequencies [Hz], kinds) of the band B stored with a run."""
+def read_modes(path: str | Path, group: str = "modes") -> tuple[np.ndarray, list[str]] | None:
+    """(natural frequencies [Hz], kinds) of the band B stored with a run (``group`` "modes": the free
+    string; "modes_drive_held": held by the drive), or None if the run stored no such group."""
     with h5py.File(path, "r") as f:
-        return f["modes/frequency"][()], [k.decode() for k in f["modes/kind"][()]]
+        if group not in f:
+            return None
+        return f[f"{group}/frequency"][()], [k.decode() for k in f[f"{group}/kind"][()]]
 
 
 def open_dataset(path: str | Path):

@@ -33,6 +33,8 @@ SUPPORTS = {
     # v, w fixed at both ends, all rotations free.
     "pinned": ((V, 0), (W, 0), (V, 1), (W, 1)),
 }
+#: What the drive holds during a run (the Lagrange multipliers of (70)-(76)): u and theta_x at x = 0.
+DRIVE = ((U, 0), (THETA_X, 0))
 
 
 def field_degrees(element_degree: int) -> tuple[int, ...]:
@@ -94,10 +96,11 @@ class BeamDiscretization:
         """Dofs held at zero by the supports (the Dirichlet rows of the modal problem)."""
         return np.array(sorted(self.end_dof(f, e) for f, e in SUPPORTS[self.supports]), dtype=np.int32)
 
-    def support_bcs(self) -> list[fem.DirichletBC]:
-        """Homogeneous Dirichlet conditions for the supports, one per constrained field/end."""
+    def support_bcs(self, held: tuple = ()) -> list[fem.DirichletBC]:
+        """Homogeneous Dirichlet conditions for the supports and the ``held`` (field, end) pairs (for
+        example :data:`DRIVE`), one per constrained field/end."""
         bcs = []
-        for field, end in SUPPORTS[self.supports]:
+        for field, end in (*SUPPORTS[self.supports], *held):
             dof = np.array([self.end_dof(field, end)], dtype=np.int32)
             bcs.append(fem.dirichletbc(np.float64(0.0), dof, self.V.sub(field)))
         return bcs

@@ -95,9 +95,12 @@ def _solve_eps(K: PETSc.Mat, M: PETSc.Mat, nev: int, target: float) -> SLEPc.EPS
     return eps
 
 
-def solve_modes(disc: BeamDiscretization, f_star_max: float, mass=None, safety: float = 1.15) -> ModalBasis:
+def solve_modes(disc: BeamDiscretization, f_star_max: float, mass=None, held: tuple = (),
+                safety: float = 1.15) -> ModalBasis:
     """All modes with f* = f L / c_L <= ``f_star_max`` (Eq. 95), sorted by frequency; ``mass`` is the
     assembled free-free M (SciPy) used to normalise and classify them (assembled here if not given).
+    ``held`` adds (field, end) pairs to the supports: with :data:`~fenics_drill.model.discretization.DRIVE`,
+    the modes of the string held by the drive as in a run (axial and torsional quarter waves).
 
     The number of requested eigenpairs starts from the closed-form estimate and
     grows until the highest converged mode lies above the band.
@@ -105,18 +108,19 @@ def solve_modes(disc: BeamDiscretization, f_star_max: float, mass=None, safety: 
     p = disc.properties
     c_L = p.longitudinal_wave_speed
     f_max = f_star_max * c_L / p.length
-    K, M = assemble_modal_pair(disc)
+    K, M = assemble_modal_pair(disc, held)
     mass = assemble_linear(disc).mass if mass is None else mass
     # The target sits below zero so K - target*M is positive definite despite the rigid modes.
     target = -((2.0 * math.pi * 1e-3 * c_L / p.length) ** 2)
     nev = max(8, int(safety * estimated_mode_count(disc, f_max)) + 4)
-    nev = min(nev, disc.ndofs - len(disc.support_dofs) - 1)
+    constrained = len(disc.support_dofs) + len(held)
+    nev = min(nev, disc.ndofs - constrained - 1)
     while True:
         eps = _solve_eps(K, M, nev, target)
         nconv = eps.getConverged()
         eigenvalues = np.array([eps.getEigenvalue(i).real for i in range(nconv)])
         top_hz = math.sqrt(max(eigenvalues.max(), 0.0)) / (2 * math.pi) if nconv else 0.0
-        free_dofs = disc.ndofs - len(disc.support_dofs)
+        free_dofs = disc.ndofs - constrained
         if (nconv >= nev and top_hz > f_max) or nev >= free_dofs - 1:
             break
         nev = min(2 * nev, free_dofs - 1)

@@ -62,14 +62,15 @@ def assemble_linear(disc: BeamDiscretization) -> LinearOperators:
     return LinearOperators(mat(m), mat(c), mat(k), gravity)
 
 
-def assemble_modal_pair(disc: BeamDiscretization) -> tuple[PETSc.Mat, PETSc.Mat]:
-    """K and M for the modal problem (62), support dofs as Dirichlet rows.
+def assemble_modal_pair(disc: BeamDiscretization, held: tuple = ()) -> tuple[PETSc.Mat, PETSc.Mat]:
+    """K and M for the modal problem (62), support dofs (and the ``held`` (field, end) pairs) as
+    Dirichlet rows.
 
     K gets 1 and M gets 0 on the diagonal of each constrained row/column, so the
     constrained dofs carry infinite eigenvalues that shift-and-invert never finds.
     """
     m, _, k, _ = _forms(disc)
-    bcs = disc.support_bcs()
+    bcs = disc.support_bcs(held)
     K = fem_petsc.assemble_matrix(k, bcs=bcs, diag=1.0)
     K.assemble()
     M = fem_petsc.assemble_matrix(m, bcs=bcs, diag=0.0)

@@ -87,9 +87,11 @@ SIGNALS = {
 
 
 def run_spectra(series: dict, modal_frequencies: np.ndarray, modal_kinds: list[str], peaks: int = 2,
-                min_frequency: float = 1.0) -> dict:
+                min_frequency: float = 1.0, held_modes: tuple | None = None) -> dict:
     """PSD (raw and smoothed, dB/Hz) of every signal of SIGNALS, with its ``peaks`` highest peaks
-    above ``min_frequency`` (on the smoothed curve) and the nearest natural frequencies."""
+    above ``min_frequency`` (on the smoothed curve) and the nearest natural frequencies: of the free
+    string, and, given ``held_modes`` = (frequencies, kinds), of the string held by the drive at x = 0
+    as it is during a run (``held_mode_*``)."""
     t = series["time"]
     grid = uniform_grid(t)
     step = grid[1] - grid[0]
@@ -102,6 +104,9 @@ def run_spectra(series: dict, modal_frequencies: np.ndarray, modal_kinds: list[s
         found = spectral_peaks(freq, smoothed, peaks, min_frequency) if np.any(psd > 0) else []
         for peak in found:
             peak.update(nearest_mode(peak["frequency_hz"], modal_frequencies, modal_kinds))
+            if held_modes is not None:
+                held = nearest_mode(peak["frequency_hz"], *held_modes)
+                peak.update({f"held_{key}": value for key, value in held.items()})
         out[name] = {"label": label, "psd_unit": unit, "figure": figure, "frequency_hz": freq,
                      "psd_db": raw, "smoothed_db": smoothed, "peaks": found}
     return out

@@ -63,6 +63,14 @@ def time_series_figures(data: dict, attrs: dict, out: Path) -> list[Path]:
     return paths
 
 
+def _peak_label(peak: dict) -> str:
+    """A peak and the nearest modes: of the free string and, if known, of the string held by the drive."""
+    text = f"{peak['frequency_hz']:.2f} Hz (nearest mode: {peak['mode_kind']} {peak['mode_frequency_hz']:.2f} Hz"
+    if "held_mode_kind" in peak:
+        text += f"; held by the drive: {peak['held_mode_kind']} {peak['held_mode_frequency_hz']:.2f} Hz"
+    return text + ")"
+
+
 def spectra_figures(spectra: dict, out: Path) -> list[Path]:
     """Figs. 21-23: raw periodogram (magenta) and Savitzky-Golay smoothed PSD (blue), peaks marked."""
     paths = []
@@ -76,8 +84,7 @@ def spectra_figures(spectra: dict, out: Path) -> list[Path]:
             found = s["peaks"]
             if found:
                 ax.plot([p["frequency_hz"] for p in found], [p["psd_db"] for p in found], "kv", ms=5)
-                text = "\n".join(f"{p['frequency_hz']:.2f} Hz (nearest mode: {p['mode_kind']} "
-                                 f"{p['mode_frequency_hz']:.2f} Hz)" for p in found)
+                text = "\n".join(_peak_label(p) for p in found)
                 ax.text(0.99, 0.96, text, transform=ax.transAxes, ha="right", va="top", fontsize=7,
                         bbox={"facecolor": "white", "alpha": 0.8, "lw": 0})
             visible = s["smoothed_db"][s["frequency_hz"] > 1.0]
@@ -102,7 +109,8 @@ def spectra_json(spectra: dict) -> dict:
 def run_spectra_of(run_dir: Path) -> dict:
     """Spectra of a saved run, peaks named by the modes stored with it."""
     data, _ = read_series(run_dir / "timeseries.h5")
-    return run_spectra(data, *read_modes(run_dir / "timeseries.h5"))
+    path = run_dir / "timeseries.h5"
+    return run_spectra(data, *read_modes(path), held_modes=read_modes(path, "modes_drive_held"))
 
 
 def plot_run(run_dir: Path, gif: bool = True) -> list[Path]:
