@@ -8,11 +8,7 @@ Reuses ``RUNS/<name>`` when its summary says the run finished.
 
 from __future__ import annotations
 
-import argparse
-import json
-import subprocess
-import sys
-from pathlib import Path
+from scene_runs import run_once, study_arguments, write_table
 
 CASES = {
     "consistent_objectivekin": ("consistent laws, objective kinematics (the default)", []),
@@ -30,11 +26,7 @@ CASES = {
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--t-end", type=float, default=3.0)
-    parser.add_argument("--runs", type=Path, default=Path("out/reproduction"))
-    parser.add_argument("--table", type=Path, default=Path("docs/printed_laws.md"))
-    args = parser.parse_args()
+    args = study_arguments(__doc__, 3.0, "out/reproduction", "docs/printed_laws.md")
     lines = [f"# The printed laws one at a time: `demos/scenes/paper.toml`, {args.t_end} s", "",
              f"Command: `python benchmarks/printed_laws.py --t-end {args.t_end}` (reduced model, default basis). "
              "V0 = 20 m/h, Omega = 60 rpm. Work: what each printed law put into the string (kJ).", "",
@@ -42,14 +34,7 @@ def main() -> None:
              "| impacts | shock packages | max σ_VM [MPa] | work of the printed laws [kJ] |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, (label, overrides) in CASES.items():
-        out = args.runs / name
-        summary = out / "summary.json"
-        if not (summary.exists() and json.loads(summary.read_text()).get("status") in ("finished", "suspect")):
-            sets = [a for o in overrides for a in ("--set", o)]
-            subprocess.run([sys.executable, "-m", "fenics_drill.cli", "run", "demos/scenes/paper.toml",
-                            "--set", f"time.t_end={args.t_end}", *sets, "--quiet", "--overwrite", "--out", str(out)],
-                           check=False)
-        s = json.loads(summary.read_text())
+        s = run_once(args.runs / name, args.t_end, overrides)
         bounce, slip = s["bit_bounce"], s["stick_slip"]
         injected = ", ".join(f"{k} {v / 1e3:.2f}" for k, v in s["energy"]["injected_by"].items()) or "—"
         lines.append(f"| {label} | {s['rop'] * 3600:.2f} | {bounce['off_bottom_fraction']:.2%} | "
@@ -57,8 +42,7 @@ def main() -> None:
                      f"{slip['omega_min_ratio']:.2f} … {slip['omega_max_ratio']:.2f} | {slip['stick_slip_severity']:.2f} | "
                      f"{s['efficiency']:.1%} | {s['impacts_total']} | {s['shock_packages']} | "
                      f"{s['max_von_mises']['value'] / 1e6:.0f} | {injected} |")
-    args.table.write_text("\n".join(lines) + "\n")
-    print("\n".join(lines))
+    write_table(args.table, lines)
 
 
 if __name__ == "__main__":

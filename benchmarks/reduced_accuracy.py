@@ -11,32 +11,24 @@ of the bit velocity and wall time, with the relative difference from the full or
 
 from __future__ import annotations
 
-import argparse
-import json
-import subprocess
-import sys
 from pathlib import Path
 
 import h5py
 import numpy as np
+from scene_runs import SCENE, run_once, study_arguments, write_table
 
-SCENE = "demos/scenes/paper.toml"
 MODELS = {
-    "full": ["--set", "reduction.rule='none'"],
+    "full": ["reduction.rule='none'"],
     "reduced (default: paper rule + guard)": [],
-    "paper modal basis (enrich off)": ["--set", "reduction.enrich=false", "--set", "reduction.guard_tolerance=1"],
+    "paper modal basis (enrich off)": ["reduction.enrich=false", "reduction.guard_tolerance=1"],
 }
 KINEMATICS = ("objective", "printed")
 TARGETS = {"rop": 0.01, "efficiency": 0.01, "mean_bit_velocity": 0.01, "max_von_mises": 0.05, "bit_velocity_rms": 0.10}
 
 
-def run(name: str, args: list[str], t_end: float, runs: Path) -> dict:
+def run(name: str, overrides: list[str], t_end: float, runs: Path) -> dict:
     out = runs / name
-    summary = out / "summary.json"
-    if not (summary.exists() and json.loads(summary.read_text()).get("status") in ("finished", "suspect")):
-        subprocess.run([sys.executable, "-m", "fenics_drill.cli", "run", SCENE, "--set", f"time.t_end={t_end}",
-                        *args, "--quiet", "--overwrite", "--out", str(out)], check=False)
-    s = json.loads(summary.read_text())
+    s = run_once(out, t_end, overrides)
     with h5py.File(out / "timeseries.h5") as f:
         t, v = f["time"][()], f["bit_velocity"][()]
     mean = np.trapezoid(v, t) / (t[-1] - t[0])
@@ -47,11 +39,7 @@ def run(name: str, args: list[str], t_end: float, runs: Path) -> dict:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--t-end", type=float, default=2.0)
-    parser.add_argument("--runs", type=Path, default=Path("out/accuracy"))
-    parser.add_argument("--table", type=Path, default=Path("benchmarks/reduced_accuracy.md"))
-    args = parser.parse_args()
+    args = study_arguments(__doc__, 2.0, "out/accuracy", "benchmarks/reduced_accuracy.md")
     lines = [f"# Reduced models against the full order: `{SCENE}`, t_end = {args.t_end} s", "",
              f"Command: `python benchmarks/reduced_accuracy.py --t-end {args.t_end}`. Relative differences from "
              "the full order (500 elements, the same adaptive steps); targets of issue 14 in brackets.", ""]
@@ -59,7 +47,7 @@ def main() -> None:
               "| peak von Mises [MPa] | RMS bit velocity [m/h] | wall [s] | speed-up |")
     lines += [header, "|" + "---|" * (header.count("|") - 1)]
     for kinematics in KINEMATICS:
-        results = {model: run(f"{kinematics}-{i}", [*extra, "--set", f"model.kinematics={kinematics}"], args.t_end,
+        results = {model: run(f"{kinematics}-{i}", [*extra, f"model.kinematics={kinematics}"], args.t_end,
                               args.runs) for i, (model, extra) in enumerate(MODELS.items())}
         full = results["full"]
         for model, r in results.items():
@@ -77,8 +65,7 @@ def main() -> None:
                          f"{full['wall_time_s'] / r['wall_time_s']:.1f}× |")
     lines += ["", "Targets: rop, efficiency, mean bit velocity within 1 %; peak von Mises within 5 %; RMS of the bit "
               "velocity within 10 %; at least 20× faster than the full order. ✗ marks a miss."]
-    args.table.write_text("\n".join(lines) + "\n")
-    print("\n".join(lines))
+    write_table(args.table, lines)
 
 
 if __name__ == "__main__":
