@@ -57,22 +57,23 @@ def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
 
 
 class Progress:
-    """One line on stderr every few seconds: simulated time, steps, step size, wall time, ETA."""
+    """A progress report on stderr: simulated time, steps, step size, wall time, ETA.  On a terminal one
+    line rewritten every 2 s; in a log file (a batch job) one line every 30 s."""
 
-    def __init__(self, enabled: bool, every_s: float = 2.0):
-        self.enabled, self.every_s, self.last = enabled, every_s, -np.inf
+    def __init__(self, enabled: bool, every_s: float | None = None):
+        self.terminal = sys.stderr.isatty()
+        self.every_s = every_s if every_s is not None else (2.0 if self.terminal else 30.0)
+        self.enabled, self.last = enabled, -np.inf
 
     def __call__(self, t, t_end, stats, dt, wall):
         if not self.enabled or (wall - self.last < self.every_s and t < t_end):
             return
         self.last = wall
         eta = wall * (t_end - t) / t if t > 0 else float("nan")
-        sys.stderr.write(
-            f"\r  t = {t:8.4f} / {t_end:g} s ({100 * t / t_end:5.1f}%)  steps {stats['steps']:7d}  "
-            f"dt {dt:.2e} s  wall {wall:7.1f} s  eta {eta:7.1f} s"
-        )
-        if t >= t_end * (1 - 1e-12):
-            sys.stderr.write("\n")
+        line = (f"  t = {t:8.4f} / {t_end:g} s ({100 * t / t_end:5.1f}%)  steps {stats['steps']:7d}  "
+                f"dt {dt:.2e} s  wall {wall:7.1f} s  eta {eta:7.1f} s")
+        done = t >= t_end * (1 - 1e-12)
+        sys.stderr.write(f"\r{line}" + ("\n" if done else "") if self.terminal else f"{line}\n")
         sys.stderr.flush()
 
 
