@@ -2,7 +2,7 @@
 PY := .venv/bin/python
 OUT ?= out
 
-.PHONY: setup demo demo-printed demo-as-printed test bench mc optimize clean
+.PHONY: setup demo demo-printed demo-as-printed test bench bench-ross campbell mc optimize clean
 
 setup:
 	@bash scripts/bootstrap.sh
@@ -38,6 +38,20 @@ bench: setup
 	$(PY) benchmarks/modal_timing.py
 	$(PY) benchmarks/dynamics_convergence.py
 	$(PY) benchmarks/tradeoff.py demos/scenes/paper.toml --t-end 0.5
+
+## Campbell diagram against ROSS (benchmarks/campbell_ross.md).  ROSS lives in its own .venv-ross: its
+## dependencies (CoolProp, pyarrow, ...) are not the project's, and once installed beside DOLFINx they broke
+## h5py's import here (measured: "ValueError: Not a datatype").
+bench-ross: setup
+	@test -x .venv-ross/bin/python || ($$(head -1 .venv/pyvenv.cfg | sed 's/home = //')/python3 -m venv .venv-ross \
+		&& .venv-ross/bin/pip install -q ross-rotordynamics==3.1.0)
+	$(PY) benchmarks/campbell_ross.py --ross-python .venv-ross/bin/python --rounds 2
+
+## Critical speeds of the paper's string on the wall, without and with the weight on bit (docs/campbell.md).
+campbell: setup
+	$(PY) -m fenics_drill.cli campbell demos/scenes/campbell_paper.toml --overwrite --out $(OUT)/campbell
+	$(PY) -m fenics_drill.cli campbell demos/scenes/campbell_paper.toml --set campbell.weight_on_bit=true \
+		--overwrite --out $(OUT)/campbell-wob
 
 ## The paper's Monte Carlo study (Section 6.11) at SAMPLES realisations on RANKS processes.
 SAMPLES ?= 32

@@ -7,6 +7,7 @@
     run = fd.run(scene)                         # run.summary (dict), run.series (xarray.Dataset)
     mc = fd.monte_carlo(scene, samples=8, out="out/mc")
     window = fd.operating_window(scene, out="out/window")
+    diagram = fd.campbell(scene)                # campbell.json as a dict (critical speeds, whirl)
 
 Every call takes a :class:`~fenics_drill.scene.Scene`; change one with
 ``scene.with_changes(drive={"rotation_speed": 5.0})``.  The command line does the same
@@ -22,6 +23,7 @@ from pathlib import Path
 from fenics_drill.io.timeseries import open_dataset
 from fenics_drill.plots.directory import plot_directory
 from fenics_drill.scene import Scene
+from fenics_drill.studies.campbell import campbell_report, write_campbell
 from fenics_drill.studies.modal_report import modal_report
 from fenics_drill.studies.monte_carlo import monte_carlo as _monte_carlo
 from fenics_drill.studies.operating_window import run_optimize
@@ -74,6 +76,14 @@ def operating_window(scene: Scene, out: str | Path, resume: bool = False, progre
     return run_optimize(scene, out, resume=resume, progress=progress, overwrite=overwrite)
 
 
+def campbell(scene: Scene, out: str | Path | None = None, overwrite: bool = False) -> dict:
+    """Critical speeds: the modes of the string spinning over ``campbell.rotation_speed`` (campbell.json);
+    with ``out`` also written there (draw it with :func:`plot`)."""
+    if out is not None:
+        return write_campbell(scene, out, overwrite=overwrite)
+    return campbell_report(scene)
+
+
 def plot(directory: str | Path, gif: bool = False) -> list[Path]:
-    """The figures of a run, Monte Carlo study or operating window directory; returns the files."""
+    """The figures of a run, Monte Carlo study, operating window or Campbell directory; returns the files."""
     return plot_directory(Path(directory), gif=gif)

@@ -18,7 +18,7 @@ from pathlib import Path
 from fenics_drill.scene import SceneError, load_scene, section_keys
 
 #: Commands run in a supervised worker process (single-process commands that can run long).
-SUPERVISED = ("run", "static", "modal")
+SUPERVISED = ("run", "static", "modal", "campbell")
 
 
 def _scene_args(parser: argparse.ArgumentParser, out: bool = True) -> None:
@@ -71,6 +71,24 @@ def cmd_static(args) -> int:
         f"max sag {report['max_sag'] * 1e3:.3f} mm at x = {report['max_sag_position']:.1f} m, "
         f"{len(report['contact_vertices'])} vertices on the wall -> {Path(args.out) / 'static.json'}"
     )
+    return 0
+
+
+def cmd_campbell(args) -> int:
+    """Critical speeds: the modes of the spinning string over campbell.rotation_speed (DIR/campbell.json, .png)."""
+    from fenics_drill.plots.campbell import campbell_figure
+    from fenics_drill.studies.campbell import write_campbell
+
+    scene = load_scene(args.scene, args.overrides)
+    report = write_campbell(scene, args.out, overwrite=args.overwrite)
+    campbell_figure(report, Path(args.out) / "campbell.png")
+    speeds = report["rotation_speed_rpm"]
+    print(f"{len(report['branches'])} branches at {len(speeds)} speeds {speeds[0]:.4g}-{speeds[-1]:.4g} rpm, axial "
+          f"compression {report['axial_force_N']:.4g} N [{report['wall_time_s']:.1f} s] -> "
+          f"{Path(args.out) / 'campbell.json'}")
+    for c in report["critical_speeds"]:
+        print(f"  critical speed {c['speed_rpm']:8.2f} rpm: {c['order']:g}x line meets a {c['whirl']} {c['kind']} "
+              f"branch at {c['frequency_hz']:.3f} Hz")
     return 0
 
 
@@ -189,6 +207,10 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("static", help="static equilibrium under gravity (Section 6.4): DIR/static.json")
     _scene_args(p)
     p.set_defaults(func=cmd_static)
+    p = sub.add_parser("campbell", help="critical speeds: Campbell diagram of the spinning string, whirl, "
+                                        "weight on bit: DIR/campbell.json, campbell.png")
+    _scene_args(p)
+    p.set_defaults(func=cmd_campbell)
     p = sub.add_parser("run", help="drilling dynamics: DIR/summary.json, timeseries.h5, fields.xdmf")
     _scene_args(p)
     p.add_argument("--quiet", action="store_true", help="no progress line")
@@ -205,9 +227,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true", help="continue in --out, skipping the points done")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_optimize)
-    p = sub.add_parser("plot", help="figures of a run (Figs. 13-23, spectra.json, animation.gif) or of a "
-                                    "Monte Carlo study (Figs. 28-35)")
-    p.add_argument("run_dir", help="the --out directory of 'fenics-drill run' or 'fenics-drill mc'")
+    p = sub.add_parser("plot", help="figures of a run (Figs. 13-23, spectra.json, animation.gif), a Monte Carlo "
+                                    "study (Figs. 28-35), an operating window or a Campbell diagram")
+    p.add_argument("run_dir", help="the --out directory of 'fenics-drill run', 'mc', 'optimize' or 'campbell'")
     p.add_argument("--no-gif", action="store_true", help="skip the animation (the slowest part)")
     p.set_defaults(func=cmd_plot)
     p = sub.add_parser("forms", help="list/show the weak forms, or check the printed ones against the energies")
@@ -226,9 +248,12 @@ def _user_errors() -> tuple[type, ...]:
     from fenics_drill.model.resources import ResourceError
     from fenics_drill.model.spaces import BasisError
     from fenics_drill.plots.directory import NothingToPlot
+    from fenics_drill.model.rotating_modes import Divergence
+    from fenics_drill.studies.campbell import CampbellError
     from fenics_drill.studies.uncertainty import InadmissibleLaw
 
-    return SceneError, OutputError, ResourceError, UnreadableFile, InadmissibleLaw, NothingToPlot, BasisError
+    return (SceneError, OutputError, ResourceError, UnreadableFile, InadmissibleLaw, NothingToPlot, BasisError,
+            CampbellError, Divergence)
 
 
 def _collective_errors() -> tuple[type, ...]:

@@ -168,6 +168,22 @@ class Model:
     kinematics: str = key("objective", "cross-section kinematics of the strain energy: 'objective' (strains "
                           "unchanged by a rigid spin theta_x, docs/errata.md) or 'printed' (Eq. 14 as printed)",
                           choices=("objective", "printed"))
+    angular_velocity: str = key("consistent", "angular velocity of the section in the kinetic energy (24): "
+                                "'consistent' (tilts about the inertial axes: a spinning shaft's forward whirl "
+                                "stiffens, docs/errata.md) or 'printed' (Eq. 13 as printed: the gyroscopic "
+                                "coupling reversed)", choices=("consistent", "printed"))
+
+
+def _positions(x) -> bool:
+    return all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in x)
+
+
+@dataclass(frozen=True)
+class Supports:
+    """Lateral supports besides the ends of ``model.supports``."""
+
+    stabilisers: tuple = key((), "x of pinned lateral supports, like stabilisers: v = w = 0 at the mesh vertex "
+                             "nearest each, 0 < x < beam.length [m]", _positions, "a list of numbers")
 
 
 @dataclass(frozen=True)
@@ -234,6 +250,30 @@ class Optimize:
     risk: float = key(0.1, "P_risk of the chance constraint (104) [-]", lambda x: 0 < x < 1, "in (0, 1)")
 
 
+def _orders(x) -> bool:
+    return len(x) >= 1 and _positions(x) and all(v > 0 for v in x)
+
+
+@dataclass(frozen=True)
+class Campbell:
+    """Critical-speed analysis: the modes of the string linearised about a steady spin."""
+
+    rotation_speed: tuple = key((0.0, 4.0 * math.pi, 25), "grid of the spin Omega: [min, max, points] [rad/s]",
+                                _grid_axis, _GRID)
+    modes: int = key(12, "lowest whirl frequencies followed at each speed [-]", lambda n: 1 <= n <= 500,
+                     "in [1, 500]")
+    state: str = key("straight", "what the modes are linearised about: 'straight' (the straight string, gravity "
+                     "and wall left out) or 'static' (the static equilibrium on the wall under gravity, with the "
+                     "linearised wall stiffness)", choices=("straight", "static"))
+    axial_force: float = key(0.0, "axial compression at the bit [N], applied before linearising (geometric "
+                             "stiffness); see campbell.weight_on_bit")
+    weight_on_bit: bool = key(False, "true: the axial compression is the steady bit force of Eq. (20) at the "
+                              "drive's V0 (the weight on bit of a run), instead of campbell.axial_force")
+    excitation_orders: tuple = key((1.0, 3.0), "orders n of the excitation lines f = n Omega / 2 pi (1: unbalance, "
+                                   "n: an n-bladed bit) [-]", _orders, "a non-empty list of numbers > 0")
+    damping: bool = key(False, "include the dissipation (38): damped frequencies and damping ratios")
+
+
 @dataclass(frozen=True)
 class Scene:
     """A validated scene: one typed, immutable section per TOML table."""
@@ -248,10 +288,12 @@ class Scene:
     solver: Solver = field(default_factory=Solver)
     output: Output = field(default_factory=Output)
     model: Model = field(default_factory=Model)
+    supports: Supports = field(default_factory=Supports)
     modal: Modal = field(default_factory=Modal)
     reduction: Reduction = field(default_factory=Reduction)
     uncertainty: Uncertainty = field(default_factory=Uncertainty)
     optimize: Optimize = field(default_factory=Optimize)
+    campbell: Campbell = field(default_factory=Campbell)
 
     def to_dict(self) -> dict[str, dict[str, Any]]:
         """The scene as nested plain values (what summary files and study directories store)."""
@@ -341,6 +383,10 @@ def _check_relations(scene: Scene) -> Scene:
     if scene.output.section > beam.length:
         raise SceneError(f"output.section = {scene.output.section!r} is not admissible: "
                          f"must be in [0, beam.length = {beam.length!r}]")
+    for x in scene.supports.stabilisers:
+        if not 0 < x < beam.length:
+            raise SceneError(f"supports.stabilisers = {list(scene.supports.stabilisers)!r} is not admissible: "
+                             f"every position must be in (0, beam.length = {beam.length!r})")
     if scene.model.contact and scene.contact.stiffness_linear == 0:
         raise SceneError("contact.stiffness_linear = 0.0 is not admissible with model.contact = true: without "
                          "its linear spring the wall lets the string through (k_FS2 delta^3 is negligible at small "

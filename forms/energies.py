@@ -90,19 +90,32 @@ def strain_energy_density(p: BeamProperties, s: dict, geometric_nonlinearity: bo
     return 0.5 * (E * (exx * exx).integrate(ro, ri) + 4.0 * kG * (exy * exy + exz * exz).integrate(ro, ri))
 
 
-def angular_velocity(U, V, inertial_nonlinearity: bool = True):
-    """omega of Eq. (13) in the inertial frame (small transverse rotations); linearised if asked."""
+#: Angular velocity of the section (docs/errata.md, "Angular velocity (13)"): 'consistent' takes the
+#: tilts theta_y, theta_z about the inertial axes, as the strains do (theta_y = -w', theta_z = v' at
+#: zero shear), so the spin component is theta_x_dot - theta_z_dot theta_y and a spinning shaft's
+#: forward whirl stiffens; 'printed' is Eq. (13), theta_x_dot + theta_z_dot theta_y, whose gyroscopic
+#: coupling has the opposite sign (forward whirl softens).
+ANGULAR_VELOCITY = ("consistent", "printed")
+
+
+def angular_velocity(U, V, inertial_nonlinearity: bool = True, form: str = "consistent"):
+    """omega in the inertial frame (small transverse rotations), Eq. (13) with the sign of ``form``;
+    linearised if asked."""
+    if form not in ANGULAR_VELOCITY:
+        raise ValueError(f"unknown angular velocity {form!r}; expected one of {ANGULAR_VELOCITY}")
     if not inertial_nonlinearity:
         return V[3], V[4], V[5]
     S, C = ufl.sin(U[3]), ufl.cos(U[3])
-    return V[3] + V[5] * U[4], V[4] * C - V[5] * S, V[4] * S + V[5] * C
+    spin_sign = 1.0 if form == "printed" else -1.0
+    return V[3] + spin_sign * V[5] * U[4], V[4] * C - V[5] * S, V[4] * S + V[5] * C
 
 
-def kinetic_energy_density(p: BeamProperties, U, V, inertial_nonlinearity: bool = True):
+def kinetic_energy_density(p: BeamProperties, U, V, inertial_nonlinearity: bool = True,
+                           angular_velocity_form: str = "consistent"):
     """Kinetic energy per unit length, Eq. (24): translation plus omega . J omega / 2 with the
     section inertia tensor J = rho diag(2 I4, I4, I4) of Eq. (23)."""
     s = p.section
-    w1, w2, w3 = angular_velocity(U, V, inertial_nonlinearity)
+    w1, w2, w3 = angular_velocity(U, V, inertial_nonlinearity, angular_velocity_form)
     translational = 0.5 * p.density * s.area * (V[0] ** 2 + V[1] ** 2 + V[2] ** 2)
     rotational = 0.5 * p.density * s.I4 * (2.0 * w1**2 + w2**2 + w3**2)
     return translational + rotational
@@ -116,9 +129,10 @@ def dissipation_density(p: BeamProperties, V):
     )
 
 
-def inertial_force(p: BeamProperties, psi, U, V, A, dx, inertial_nonlinearity: bool = True):
+def inertial_force(p: BeamProperties, psi, U, V, A, dx, inertial_nonlinearity: bool = True,
+                   angular_velocity_form: str = "consistent"):
     """Lagrange's d/dt dT/dV - dT/dU as a linear form in psi (= M(psi, A) - F_KE(psi), Eqs. 44, 48)."""
-    T = kinetic_energy_density(p, U, V, inertial_nonlinearity) * dx
+    T = kinetic_energy_density(p, U, V, inertial_nonlinearity, angular_velocity_form) * dx
     momentum = ufl.derivative(T, V, psi)
     return ufl.derivative(momentum, U, V) + ufl.derivative(momentum, V, A) - ufl.derivative(T, U, psi)
 

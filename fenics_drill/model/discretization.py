@@ -46,13 +46,16 @@ def field_degrees(element_degree: int) -> tuple[int, ...]:
 class BeamDiscretization:
     """The interval mesh [0, L], the mixed space and the dofs of each field (serial, COMM_SELF)."""
 
-    def __init__(self, properties: BeamProperties, elements: int, element_degree: int = 2, supports: str = "paper"):
+    def __init__(self, properties: BeamProperties, elements: int, element_degree: int = 2, supports: str = "paper",
+                 stabilisers: tuple = ()):
+        """``stabilisers``: x of pinned lateral supports inside the string (v = w = 0 at the nearest vertex)."""
         if supports not in SUPPORTS:
             raise ValueError(f"unknown supports {supports!r}; expected one of {', '.join(SUPPORTS)}")
         self.properties = properties
         self.elements = elements
         self.element_degree = element_degree
         self.supports = supports
+        self.stabilisers = tuple(stabilisers)
         self.comm = MPI.COMM_SELF
         self.mesh = mesh.create_interval(self.comm, self.elements, [0.0, self.properties.length])
         sub = [basix.ufl.element("Lagrange", "interval", d) for d in field_degrees(self.element_degree)]
@@ -63,7 +66,8 @@ class BeamDiscretization:
         """The discretization a scene asks for (``beam.*``, ``model.supports``); refused before any
         allocation if it does not fit in memory (:mod:`fenics_drill.model.resources`)."""
         check_memory(scene.beam.elements, scene.beam.element_degree)
-        return cls(scene.beam_properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports)
+        return cls(scene.beam_properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports,
+                   scene.supports.stabilisers)
 
     @property
     def ndofs(self) -> int:
@@ -92,18 +96,26 @@ class BeamDiscretization:
         return int(dofs[0])
 
     @cached_property
+    def stabiliser_vertices(self) -> np.ndarray:
+        """Indices into :attr:`vertex_x` of the vertices nearest the stabilisers (v = w = 0 there)."""
+        return np.array(sorted({int(np.argmin(np.abs(self.vertex_x - x))) for x in self.stabilisers}), dtype=int)
+
+    def _stabiliser_dofs(self) -> list[tuple[int, int]]:
+        """(field, dof) of v and w at every stabiliser vertex."""
+        return [(field, int(self.vertex_dofs(field)[i])) for i in self.stabiliser_vertices for field in (V, W)]
+
+    @cached_property
     def support_dofs(self) -> np.ndarray:
-        """Dofs held at zero by the supports (the Dirichlet rows of the modal problem)."""
-        return np.array(sorted(self.end_dof(f, e) for f, e in SUPPORTS[self.supports]), dtype=np.int32)
+        """Dofs held at zero by the supports and stabilisers (the Dirichlet rows of the modal problem)."""
+        ends = [self.end_dof(f, e) for f, e in SUPPORTS[self.supports]]
+        return np.array(sorted(ends + [dof for _, dof in self._stabiliser_dofs()]), dtype=np.int32)
 
     def support_bcs(self, held: tuple = ()) -> list[fem.DirichletBC]:
-        """Homogeneous Dirichlet conditions for the supports and the ``held`` (field, end) pairs (for
-        example :data:`DRIVE`), one per constrained field/end."""
-        bcs = []
-        for field, end in (*SUPPORTS[self.supports], *held):
-            dof = np.array([self.end_dof(field, end)], dtype=np.int32)
-            bcs.append(fem.dirichletbc(np.float64(0.0), dof, self.V.sub(field)))
-        return bcs
+        """Homogeneous Dirichlet conditions for the supports, the stabilisers and the ``held`` (field, end)
+        pairs (for example :data:`DRIVE`), one per constrained dof."""
+        dofs = [(field, self.end_dof(field, end)) for field, end in (*SUPPORTS[self.supports], *held)]
+        return [fem.dirichletbc(np.float64(0.0), np.array([dof], dtype=np.int32), self.V.sub(field))
+                for field, dof in dofs + self._stabiliser_dofs()]
 
     @cached_property
     def dof_coordinates(self) -> np.ndarray:

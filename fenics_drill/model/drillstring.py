@@ -75,6 +75,12 @@ class DrillstringModel:
         model.forces = [replacement if f.name == replacement.name else f for f in self.forces]
         return model
 
+    def with_added_force(self, force) -> "DrillstringModel":
+        """A model with one more point force (built in this model's space)."""
+        model = copy.copy(self)
+        model.forces = [*self.forces, force]
+        return model
+
     def with_bit_rock(self, bit_rock) -> "DrillstringModel":
         """A model with other bit-rock parameters (a Monte Carlo realisation); nothing else depends on them."""
         bit = self.force("bit_rock")

@@ -58,7 +58,8 @@ class AssembledInternalForce:
     """Inertial (24), damping (38) and elastic (30) forces assembled from their energies."""
 
     def __init__(self, disc: BeamDiscretization, space, operators: LinearOperators,
-                 geometric_nonlinearity: bool, inertial_nonlinearity: bool, kinematics: str = "objective"):
+                 geometric_nonlinearity: bool, inertial_nonlinearity: bool, kinematics: str = "objective",
+                 angular_velocity: str = "consistent"):
         self.space = space
         p = disc.properties
         # Energies are polynomials of degree <= 4 in the fields up to sin/cos(theta_x):
@@ -67,7 +68,7 @@ class AssembledInternalForce:
         self.U, self.V, self.A = (fem.Function(disc.V) for _ in range(3))
         psi, dU = ufl.TestFunction(disc.V), ufl.TrialFunction(disc.V)
         residual = (
-            energies.inertial_force(p, psi, self.U, self.V, self.A, dx, inertial_nonlinearity)
+            energies.inertial_force(p, psi, self.U, self.V, self.A, dx, inertial_nonlinearity, angular_velocity)
             + energies.damping_force(p, psi, self.V, dx)
             + energies.elastic_force(p, psi, self.U, dx, geometric_nonlinearity, kinematics)
         )
@@ -79,7 +80,8 @@ class AssembledInternalForce:
         )
         self._residual = fem.form(residual)
         self._jacobian = fem.form(jacobian)
-        self._kinetic = fem.form(energies.kinetic_energy_density(p, self.U, self.V, inertial_nonlinearity) * dx)
+        kinetic = energies.kinetic_energy_density(p, self.U, self.V, inertial_nonlinearity, angular_velocity)
+        self._kinetic = fem.form(kinetic * dx)
         strain = energies.strain_energy_density(p, energies.strain_slots(self.U), geometric_nonlinearity, kinematics)
         self._strain = fem.form(strain * dx)
         self._vector = fem_petsc.create_vector(self._residual.function_spaces)
@@ -131,4 +133,5 @@ def internal_force(disc: BeamDiscretization, space, operators: LinearOperators, 
     geometric, inertial = model.geometric_nonlinearity, model.inertial_nonlinearity
     if not (geometric or inertial):
         return LinearInternalForce(space, operators)
-    return AssembledInternalForce(disc, space, operators, geometric, inertial, model.kinematics)
+    return AssembledInternalForce(disc, space, operators, geometric, inertial, model.kinematics,
+                                  model.angular_velocity)

@@ -1,5 +1,5 @@
-"""``fenics-drill plot DIR``: the figures of whatever DIR holds - a run, a Monte Carlo study or an
-operating window."""
+"""``fenics-drill plot DIR``: the figures of whatever DIR holds - a run, a Monte Carlo study, an
+operating window or a Campbell diagram."""
 
 from __future__ import annotations
 
@@ -15,6 +15,10 @@ class NothingToPlot(ValueError):
 
 def plot_directory(directory: Path, gif: bool = True) -> list[Path]:
     """Figs. 24-27/36 (optimize.json), 28-35 (statistics.h5) or 13-23 (timeseries.h5); the files written."""
+    if (directory / "campbell.json").exists():
+        from fenics_drill.plots.campbell import campbell_figure
+
+        return [campbell_figure(read_json(directory / "campbell.json"), directory / "campbell.png")]
     if (directory / "optimize.json").exists():
         from fenics_drill.plots.window import optimize_figures
 
@@ -29,7 +33,8 @@ def plot_directory(directory: Path, gif: bool = True) -> list[Path]:
         _check_run(directory)
         return plot_run(directory, gif=gif)
     raise NothingToPlot(f"{directory} holds no timeseries.h5 ('fenics-drill run'), statistics.h5 "
-                        "('fenics-drill mc') or optimize.json ('fenics-drill optimize')")
+                        "('fenics-drill mc'), optimize.json ('fenics-drill optimize') or campbell.json "
+                        "('fenics-drill campbell')")
 
 
 def _check_run(directory: Path) -> None:
