@@ -45,7 +45,7 @@ bench: setup
 bench-ross: setup
 	@test -x .venv-ross/bin/python || ($$(head -1 .venv/pyvenv.cfg | sed 's/home = //')/python3 -m venv .venv-ross \
 		&& .venv-ross/bin/pip install -q ross-rotordynamics==3.1.0)
-	$(PY) benchmarks/campbell_ross.py --ross-python .venv-ross/bin/python --rounds 2
+	$(PY) benchmarks/campbell_ross.py --ross-python .venv-ross/bin/python --elements 200 --rounds 2
 
 ## Critical speeds of the paper's string on the wall, without and with the weight on bit (docs/campbell.md).
 campbell: setup
