@@ -12,28 +12,18 @@ from typing import ClassVar
 import numpy as np
 
 from fenics_drill.model.discretization import U, BeamDiscretization
-from fenics_drill.model.forces.protocol import ForceEvaluation
+from fenics_drill.model.forces.gravity import Gravity
 
 
-class AxialTipLoad:
-    """Compression ``force`` [N] (> 0 pushes the bit towards x = 0) at x = L."""
+class AxialTipLoad(Gravity):
+    """Compression ``force`` [N] (> 0 pushes the bit towards x = 0) at x = L: a constant load like
+    gravity, whose evaluation, tangent and record it shares."""
 
     name: ClassVar[str] = "axial_tip_load"
     switch: ClassVar[str] = ""
-    conservative: ClassVar[bool] = True
-    recorded: ClassVar[dict] = {}
 
     def __init__(self, disc: BeamDiscretization, space, force: float):
         self.force = force
         at_bit = np.zeros(disc.ndofs)
         at_bit[disc.end_dof(U, 1)] = -force
-        self.load = space.project(at_bit)
-
-    def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> ForceEvaluation:
-        return ForceEvaluation(self.load, -float(self.load @ q), {})
-
-    def tangent(self, evaluation: ForceEvaluation, c_u: float, c_v: float):
-        return None
-
-    def record(self, evaluation: ForceEvaluation) -> dict[str, float]:
-        return {}
+        super().__init__(space.project(at_bit))
