@@ -75,6 +75,16 @@ def estimated_mode_count(disc: BeamDiscretization, f_max_hz: float) -> int:
     return int(2 * flexural_per_plane + torsional + axial) + 2
 
 
+def shift_and_invert(st: SLEPc.ST, factorisation: str) -> None:
+    """Shift-and-invert spectral transformation with a direct MUMPS solve ('cholesky' or 'lu')."""
+    st.setType(SLEPc.ST.Type.SINVERT)
+    ksp = st.getKSP()
+    ksp.setType(PETSc.KSP.Type.PREONLY)
+    pc = ksp.getPC()
+    pc.setType(factorisation)
+    pc.setFactorSolverType("mumps")
+
+
 def _solve_eps(K: PETSc.Mat, M: PETSc.Mat, nev: int, target: float) -> SLEPc.EPS:
     eps = SLEPc.EPS().create(K.getComm())
     eps.setOperators(K, M)
@@ -83,13 +93,7 @@ def _solve_eps(K: PETSc.Mat, M: PETSc.Mat, nev: int, target: float) -> SLEPc.EPS
     eps.setDimensions(nev=nev, ncv=max(2 * nev, nev + 32))
     eps.setTarget(target)
     eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
-    st = eps.getST()
-    st.setType(SLEPc.ST.Type.SINVERT)
-    ksp = st.getKSP()
-    ksp.setType(PETSc.KSP.Type.PREONLY)
-    pc = ksp.getPC()
-    pc.setType(PETSc.PC.Type.CHOLESKY)
-    pc.setFactorSolverType("mumps")
+    shift_and_invert(eps.getST(), PETSc.PC.Type.CHOLESKY)
     eps.setTolerances(tol=1e-10, max_it=500)
     eps.solve()
     return eps

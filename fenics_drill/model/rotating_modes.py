@@ -32,7 +32,7 @@ from slepc4py import SLEPc
 
 from fenics_drill.model.discretization import DRIVE, THETA_X, THETA_Y, THETA_Z, V, W, BeamDiscretization
 from fenics_drill.model.internal_force import internal_force
-from fenics_drill.model.modes import classify
+from fenics_drill.model.modes import classify, shift_and_invert
 from fenics_drill.model.operators import LinearOperators
 from fenics_drill.model.spaces import FullSpace
 
@@ -127,13 +127,7 @@ def _solve_pep(K: PETSc.Mat, D: PETSc.Mat, M: PETSc.Mat, nev: int) -> SLEPc.PEP:
     pep.setScale(SLEPc.PEP.Scale.SCALAR)
     pep.setTarget(0.0)
     pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
-    st = pep.getST()
-    st.setType(SLEPc.ST.Type.SINVERT)
-    ksp = st.getKSP()
-    ksp.setType(PETSc.KSP.Type.PREONLY)
-    pc = ksp.getPC()
-    pc.setType(PETSc.PC.Type.LU)
-    pc.setFactorSolverType("mumps")
+    shift_and_invert(pep.getST(), PETSc.PC.Type.LU)
     pep.setTolerances(tol=1e-10, max_it=500)
     pep.solve()
     return pep
