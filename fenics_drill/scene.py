@@ -115,12 +115,40 @@ class BitRock:
     friction: float = key(0.4, "mu_BR of Eq. (21) [-]", lambda x: 0 <= x <= 1, "in [0, 1]")
     torque_law: str = key("model", "the bit torque (21): 'consistent', 'printed', or 'model' (as model.laws says)",
                           choices=("model", "consistent", "printed"))
+    law: str = key("paper", "bit-rock law: 'paper' (the velocity law (20)-(22)) or 'detournay' (cutting and "
+                   "frictional contact with the regenerative depth of cut, Richard, Germay & Detournay 2007: "
+                   "fenics_drill/model/forces/cutting_bit.py)", choices=("paper", "detournay"))
+    bit_radius: float = _pos("'detournay': bit radius a [m]", 95e-3)
+    blades: int = key(4, "'detournay': number of blades n [-]", _positive, ">= 1")
+    specific_energy: float = _pos("'detournay': intrinsic specific energy epsilon of the rock [Pa]", 60e6)
+    cutting_orientation: float = _pos("'detournay': orientation zeta of the cutting force [-]", 0.6)
+    contact_strength: float = _nonneg("'detournay': contact strength sigma under the wear flats [Pa]", 60e6)
+    wear_flat_length: float = _nonneg("'detournay': total wear-flat length l [m]", 1.2e-3)
+    geometry_factor: float = _pos("'detournay': bit geometry factor gamma of the contact torque [-]", 1.0)
+    contact_velocity: float = _pos("'detournay': regularisation of the set-valued contact: the contact force "
+                                   "grows from 0 to sigma a l as u_dot_bit goes from 0 to this, and the torque "
+                                   "changes sign over this surface speed a omega_bit [m/s]", 1e-4)
+    contact_depth: float = _pos("'detournay': regularisation of lift-off: the contact force grows from 0 to "
+                                "sigma a l as the depth of cut goes from 0 to this [m]", 1e-5)
 
 
 @dataclass(frozen=True)
 class Drive:
     axial_velocity: float = key(1.0 / 180.0, "V0, imposed axial velocity at x = 0 [m/s]")
-    rotation_speed: float = key(2.0 * math.pi, "Omega, imposed rotation speed at x = 0 [rad/s]")
+    rotation_speed: float = key(2.0 * math.pi, "Omega, imposed rotation speed at x = 0 (the set speed of a "
+                                "controller) [rad/s]")
+    mode: str = key("velocity", "axial drive: 'velocity' (u(0) = V0 t, the paper) or 'hook_load' (the top "
+                    "pushes with drive.weight_on_bit; V0 is the initial feed)", choices=("velocity", "hook_load"))
+    weight_on_bit: float = _pos("'hook_load': set weight on bit [N]; the hook load is the string's axial weight "
+                                "component (none in this horizontal hole) minus it", 25e3)
+    controller: str = key("stiff", "rotary drive: 'stiff' (theta_x(0) = Omega t, the paper), 'pi' (top drive "
+                          "with a PI speed controller, drive.proportional_gain and drive.integral_gain) or "
+                          "'soft_torque' (the PI tuned to the pipe's torsional impedance, "
+                          "fenics_drill/model/top_drive.py)", choices=("stiff", "pi", "soft_torque"))
+    top_drive_inertia: float = _pos("'pi', 'soft_torque': rotary inertia J_td of the top drive [kg m^2]", 500.0)
+    proportional_gain: float = _nonneg("'pi': k_p of the speed controller [N m s/rad]", 5e4)
+    integral_gain: float = _nonneg("'pi': k_i of the speed controller [N m/rad]", 5e5)
+    torque_limit: float = _pos("'pi', 'soft_torque': largest motor torque |T_m| [N m]", 60e3)
 
 
 @dataclass(frozen=True)
@@ -391,6 +419,18 @@ def _check_relations(scene: Scene) -> Scene:
         raise SceneError("contact.stiffness_linear = 0.0 is not admissible with model.contact = true: without "
                          "its linear spring the wall lets the string through (k_FS2 delta^3 is negligible at small "
                          "penetrations); give k_FS1 > 0, or set model.contact = false to leave the wall out")
+    bit, drive = scene.bit_rock, scene.drive
+    if bit.law == "detournay" and bit.bit_radius > hole.radius:
+        raise SceneError(f"bit_rock.bit_radius = {bit.bit_radius!r} is not admissible: must be <= borehole.radius = "
+                         f"{hole.radius!r} (the bit cuts the hole)")
+    if drive.mode == "hook_load":
+        if not scene.model.bit_rock:
+            raise SceneError("drive.mode = 'hook_load' is not admissible with model.bit_rock = false: nothing "
+                             "would hold the pushed string")
+        if bit.law == "paper" and drive.weight_on_bit >= bit.limit_force:
+            raise SceneError(f"drive.weight_on_bit = {drive.weight_on_bit!r} is not admissible with "
+                             f"bit_rock.law = 'paper': must be < bit_rock.limit_force = {bit.limit_force!r}, the "
+                             "largest force the law (20) can hold (beyond it the bit accelerates without bound)")
     red = scene.reduction
     if red.rule in ("band", "count"):
         for family in ("flexural", "torsional", "axial"):

@@ -1,13 +1,15 @@
 """The discrete drillstring of a scene: Eq. (65) plus the constraints (72), ready for Newton.
 
-    r(q, qd, qdd, mu) = f_int(q, qd, qdd) - sum_k f_k(q, qd) + [B]^T mu = 0
+    r(q, qd, qdd, mu) = f_int(q, qd, qdd) + f_td(qdd) - sum_k f_k(q, qd) - f_drive(q, qd) + [B]^T mu = 0
     [B] q = h(t) = h0 + (V0, Omega) t
 
 f_int is the projected left-hand side of (43); the f_k are the point forces the
 scene's ``model`` switches turn on (:mod:`fenics_drill.model.forces`: gravity (52),
-wall impacts (50), bit-rock (51)).  The multipliers mu are the lambda of the
-Lagrangian (74): -lambda_1 and -lambda_4 are the force and torque the drive applies
-at x = 0 (the rows of [B] the supports leave to enforce).
+wall impacts (50), bit-rock (51) or the cutting bit).  The drive (:mod:`fenics_drill.model.top_drive`)
+holds u(0) and theta_x(0) by the multipliers mu, the lambda of the Lagrangian (74), whose
+-lambda_1 and -lambda_4 are the force and torque it applies at x = 0; or it applies a weight
+on bit f_drive and a motor torque to a top drive of inertia f_td instead, and [B] keeps only
+the rows it still holds.
 
 A model is not changed behind its users' backs: :meth:`DrillstringModel.with_drive`,
 :meth:`~DrillstringModel.with_bit_rock` and :meth:`~DrillstringModel.with_force` return
@@ -27,6 +29,7 @@ from fenics_drill.model.internal_force import internal_force
 from fenics_drill.model.operators import LinearOperators, assemble_linear
 from fenics_drill.model.enrichment import augment
 from fenics_drill.model.spaces import FullSpace, ModalSpace, solution_space
+from fenics_drill.model.top_drive import DriveLoads, TopDrive
 
 
 @dataclass
@@ -37,6 +40,7 @@ class Evaluation:
     internal: np.ndarray
     external: np.ndarray
     forces: dict[str, ForceEvaluation] = field(default_factory=dict)  # by force name
+    drive: DriveLoads | None = None
     tangent: object = None
     internal_parts: tuple | None = None
 
@@ -53,10 +57,8 @@ class DrillstringModel:
         self.mass = space.project_matrix(operators.mass)
         self.internal = internal_force(disc, space, operators, scene.model)
         self.forces = build_forces(scene, disc, space, operators)
-        drive_dofs = [disc.end_dof(U, 0), disc.end_dof(THETA_X, 0)]
-        rows = space.rows(drive_dofs)
-        self.constraints = rows.toarray() if space.sparse else rows  # [B], 2 x N_red (72)
-        self.drive_rate = np.array([scene.drive.axial_velocity, scene.drive.rotation_speed])
+        self.drive = TopDrive.from_scene(scene, disc, space)
+        self.constraints = self.drive.constraints  # [B] of (72), k x N_red: the rows the drive holds
         self.lateral_rows = (space.rows(disc.vertex_dofs(V)), space.rows(disc.vertex_dofs(W)))
         self.bit_rows = space.rows([disc.end_dof(U, 1), disc.end_dof(THETA_X, 1)])
         self.operators = operators
@@ -81,6 +83,44 @@ class DrillstringModel:
         model.forces = [*self.forces, force]
         return model
 
+    @property
+    def drive_rate(self) -> np.ndarray:
+        """h_dot of (71) for the rows of [B]."""
+        return self.drive.held_rate
+
+    def at_rest(self) -> "DrillstringModel":
+        """The model with both drive dofs held (the static equilibrium of Section 6.4)."""
+        model = copy.copy(self)
+        model.drive = self.drive.at_rest()
+        model.constraints = model.drive.constraints
+        return model
+
+    def fresh(self) -> "DrillstringModel":
+        """A model whose memories (the cutting bit's surface, the controller's integral) are its own:
+        one per simulation, the shared model untouched."""
+        model = copy.copy(self)
+        model.forces = [f.fresh() if hasattr(f, "fresh") else f for f in self.forces]
+        model.drive = self.drive.fresh()
+        return model
+
+    def begin(self, t: float, q: np.ndarray) -> None:
+        """Start the memories at the initial state."""
+        self.drive.begin(t, q)
+        for force in self.forces:
+            if hasattr(force, "begin"):
+                force.begin(t, q)
+
+    def start_step(self, t_next: float) -> None:
+        """The time of the step about to be solved (the controller's reference)."""
+        self.drive.start_step(t_next)
+
+    def accept(self, t: float, q: np.ndarray, qd: np.ndarray) -> None:
+        """Show the memories an accepted step."""
+        self.drive.accept(t, q, qd)
+        for force in self.forces:
+            if hasattr(force, "accept"):
+                force.accept(t, q, qd)
+
     def with_bit_rock(self, bit_rock) -> "DrillstringModel":
         """A model with other bit-rock parameters (a Monte Carlo realisation); nothing else depends on them."""
         bit = self.force("bit_rock")
@@ -89,7 +129,9 @@ class DrillstringModel:
     def with_drive(self, axial_velocity: float, rotation_speed: float) -> "DrillstringModel":
         """A model with other drive speeds V0, Omega (a point of an operating window)."""
         model = copy.copy(self)
-        model.drive_rate = np.array([axial_velocity, rotation_speed])
+        model.drive = self.drive.with_speeds(axial_velocity, rotation_speed)
+        model.forces = [f.with_drive(axial_velocity, rotation_speed) if hasattr(f, "with_drive") else f
+                        for f in self.forces]
         return model
 
     def full_order(self) -> "DrillstringModel":
@@ -108,8 +150,8 @@ class DrillstringModel:
         """Initial velocity of Section 3.2 in reduced coordinates: u_dot = V0, theta_x_dot = Omega,
         projected with the mass as in (54) (exact: both are rigid-body motions)."""
         full = np.zeros(self.disc.ndofs)
-        full[self.disc.field_dofs[U]] = self.drive_rate[0]
-        full[self.disc.field_dofs[THETA_X]] = self.drive_rate[1]
+        full[self.disc.field_dofs[U]] = self.drive.rate[0]
+        full[self.disc.field_dofs[THETA_X]] = self.drive.rate[1]
         return self.space.solve(self.mass, self.space.project(self.operators.mass @ full))
 
     def evaluate(self, q, qd, qdd, mu, tangent_coefficients=None, internal_parts=None) -> Evaluation:
@@ -120,27 +162,35 @@ class DrillstringModel:
         those with a non-zero coefficient.
         The point forces' tangents are always fresh.
         """
-        internal = self.internal.evaluate(q, qd, qdd)
-        external = np.zeros_like(q)
+        internal = self.internal.evaluate(q, qd, qdd) + self.drive.inertia_force(qdd)
+        drive = self.drive.evaluate(q, qd)
+        external = drive.generalised.copy()
         want = tangent_coefficients is not None
         evaluations = {}
         for force in self.forces:
             evaluations[force.name] = force.evaluate(q, qd, with_tangent=want)
             external += evaluations[force.name].generalised
         residual = internal - external + self.constraints.T @ mu
-        out = Evaluation(residual, internal, external, evaluations)
+        out = Evaluation(residual, internal, external, evaluations, drive)
         if want:
             c_u, c_v, c_a = tangent_coefficients
             needed = tuple(c != 0 for c in tangent_coefficients)
             parts = internal_parts if internal_parts is not None else self.internal.tangent_parts(needed)
             out.internal_parts = parts if all(p is not None for p in parts) else None  # reusable only if whole
             J = sum(c * part for c, part in zip(tangent_coefficients, parts) if c != 0)
-            for force in self.forces:
-                force_tangent = force.tangent(evaluations[force.name], c_u, c_v)
-                if force_tangent is not None:
-                    J = J - force_tangent
+            inertia = self.drive.inertia_tangent(c_a)
+            if inertia is not None:
+                J = J + inertia
+            load_tangents = [force.tangent(evaluations[force.name], c_u, c_v) for force in self.forces]
+            for load_tangent in [*load_tangents, self.drive.tangent(drive, c_u, c_v)]:
+                if load_tangent is not None:
+                    J = J - load_tangent
             out.tangent = J
         return out
+
+    def kinetic_energy(self, q, qd) -> float:
+        """Kinetic energy (24) of the string plus that of the top drive."""
+        return self.internal.kinetic_energy(q, qd) + self.drive.kinetic_energy(qd)
 
     def potential_energy(self, evaluation: Evaluation) -> float:
         """Energy stored by the point forces at an evaluated state (gravity, wall springs)."""

@@ -108,7 +108,10 @@ def drilling_quantities(series: dict, axial_velocity: float, rotation_speed: flo
     t = series["time"]
     if len(t) < 2 or t[-1] <= t[0]:
         raise ValueError("drilling quantities need at least two instants of a run")
-    p_in = input_power(axial_velocity, rotation_speed, series["lambda_1"], series["lambda_4"])
+    # the top's own velocities where recorded (a hook-load drive or a controller does not move it at V0, Omega)
+    top_velocity = series.get("top_velocity", axial_velocity)
+    top_spin = series.get("top_angular_velocity", rotation_speed)
+    p_in = input_power(top_velocity, top_spin, series["lambda_1"], series["lambda_4"])
     p_out = output_power(series["bit_velocity"], series["bit_force"], series["bit_angular_velocity"],
                          series["bit_torque"])
     return {

@@ -21,8 +21,12 @@ STATE_VARIABLES = {
     "bit_velocity": ("m/s", "axial velocity of the bit u_dot(L)"),
     "bit_rotation": ("rad", "rotation of the bit theta_x(L)"),
     "bit_angular_velocity": ("rad/s", "angular velocity of the bit theta_x_dot(L)"),
-    "lambda_1": ("N", "Lagrange multiplier lambda_1 of (74): -lambda_1 is the force the drive applies at x = 0"),
-    "lambda_4": ("N m", "Lagrange multiplier lambda_4 of (74): -lambda_4 is the torque the drive applies at x = 0"),
+    "lambda_1": ("N", "Lagrange multiplier lambda_1 of (74): -lambda_1 is the force the drive applies at x = 0 "
+                 "(minus the weight on bit of a hook-load drive)"),
+    "lambda_4": ("N m", "Lagrange multiplier lambda_4 of (74): -lambda_4 is the torque the drive applies at x = 0 "
+                 "(minus the motor torque of a top-drive controller)"),
+    "top_velocity": ("m/s", "axial velocity of the top u_dot(0)"),
+    "top_angular_velocity": ("rad/s", "angular velocity of the top theta_x_dot(0)"),
     "impacts": ("1", "vertices whose wall contact began during the step"),
     "section_v": ("m", "lateral displacement v at the recorded section"),
     "section_w": ("m", "lateral displacement w at the recorded section"),
@@ -66,10 +70,13 @@ class StepRows:
         dv, dw, dsx = (float((rows @ s.qd)[0]) for rows in self.section_rows)
         stress, stress_x = self.stress.maximum(dofs) if self.stress is not None else (np.nan, np.nan)
         budget = record.budget
+        force, torque = self.model.drive.applied(s.mu, record.evaluation.drive)
+        top_velocity, top_spin = self.model.drive.velocities(s.qd)
         row = {
             "time": s.t, "dt": record.dt, "newton_iterations": record.newton_iterations,
             "bit_displacement": u, "bit_velocity": du, "bit_rotation": tx, "bit_angular_velocity": dtx,
-            "lambda_1": s.mu[0], "lambda_4": s.mu[1], "impacts": int(record.onsets.sum()),
+            "lambda_1": -force, "lambda_4": -torque, "top_velocity": top_velocity,
+            "top_angular_velocity": top_spin, "impacts": int(record.onsets.sum()),
             "section_v": v, "section_w": w, "section_v_velocity": dv, "section_w_velocity": dw,
             "section_theta_x_velocity": dsx, "max_von_mises": stress, "max_von_mises_x": stress_x,
             "kinetic_energy": budget.kinetic, "strain_energy": budget.strain,

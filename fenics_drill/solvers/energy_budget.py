@@ -1,8 +1,9 @@
 """Energy budget of a run: E(t) - E(0) = W_drive - D, term by term.
 
-Mechanical energy E = T (24) + strain energy (30) + the potentials of the point forces
-(gravity -F_G . U, wall springs k1 delta^2 / 2 + k2 delta^4 / 4).  The drive's work is
-int lambda . h_dot dt; the viscous damping (38) dissipates; and every non-conservative law of
+Mechanical energy E = T (24) (plus the top drive's J_td theta_x_dot(0)^2 / 2) + strain energy (30) +
+the potentials of the point forces (gravity -F_G . U, wall springs k1 delta^2 / 2 + k2 delta^4 / 4).
+The drive's work is int lambda . h_dot dt for what it holds, and the work of the weight on bit and
+motor torque it applies otherwise; the viscous damping (38) dissipates; and every non-conservative law of
 the point forces does its own work, booked under its name: ``wall_damper`` (17),
 ``wall_axial_friction`` (18), ``wall_friction_torque`` (19), ``bit_rock_force`` (20),
 ``bit_rock_torque`` (21).  A law that dissipates does negative work; one that injects energy
@@ -28,7 +29,8 @@ class PowerTerms:
     """The generalised forces of one state that enter the budget."""
 
     drive: np.ndarray  # lambda (force, torque applied by the drive at x = 0)
-    drive_displacement: np.ndarray  # B q: (u(0), theta_x(0))
+    drive_displacement: np.ndarray  # B q: the held ones of (u(0), theta_x(0))
+    drive_loads: np.ndarray  # the generalised weight on bit and motor torque of a drive that applies them
     damping: np.ndarray  # C qd
     laws: dict[str, np.ndarray]  # the non-conservative generalised force of each law of the point forces
 
@@ -51,6 +53,7 @@ class EnergyBudget:
     def advance(self, old: PowerTerms, new: PowerTerms, dq: np.ndarray) -> None:
         """Add the work of one step."""
         self.input_work += 0.5 * float((old.drive + new.drive) @ (new.drive_displacement - old.drive_displacement))
+        self.input_work += 0.5 * float((old.drive_loads + new.drive_loads) @ dq)
         self.dissipated["damping"] += 0.5 * float((old.damping + new.damping) @ dq)
         for name in {**old.laws, **new.laws}:  # a law present at one end of the step only works from that end
             total = sum(laws[name] for laws in (old.laws, new.laws) if name in laws)

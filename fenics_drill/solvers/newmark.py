@@ -64,13 +64,13 @@ class NewmarkNewton:
         return max(np.linalg.norm(ev.internal), np.linalg.norm(ev.external), np.linalg.norm(mu_force),
                    np.linalg.norm(inertia), 1e-30)
 
-    def initial_acceleration(self, q, qd, mu_guess) -> tuple[np.ndarray, np.ndarray]:
+    def initial_acceleration(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
         """qdd(0) and mu(0) from (65) and the twice-differentiated constraint (h'' = 0)."""
         zero = np.zeros_like(q)
-        ev = self.model.evaluate(q, qd, zero, np.zeros_like(mu_guess), tangent_coefficients=(0.0, 0.0, 1.0))
+        held = np.zeros(self.model.constraints.shape[0])
+        ev = self.model.evaluate(q, qd, zero, held, tangent_coefficients=(0.0, 0.0, 1.0))
         self._internal_parts, self._steps_since_tangent = ev.internal_parts, 0
-        qdd, mu = self.model.space.saddle_solve(ev.tangent, self.model.constraints, -ev.residual,
-                                                np.zeros(len(mu_guess)))
+        qdd, mu = self.model.space.saddle_solve(ev.tangent, self.model.constraints, -ev.residual, held)
         return qdd, mu
 
     def step(self, state: State, dt: float, h0: np.ndarray) -> tuple[State, int, Evaluation]:

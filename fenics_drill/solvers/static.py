@@ -53,6 +53,7 @@ def solve_static(model: DrillstringModel, tolerance: float = 1e-8, max_iteration
     (:data:`STIFFNESS_STAGES`) on copies of the model; the model itself is left as it was.  From an
     ``initial`` guess near the equilibrium (the full-order state projected on a reduced basis), one
     Newton solve with the real wall."""
+    model = model.at_rest()  # both drive dofs held, whatever drives the run
     q, mu = (np.zeros(model.size) if initial is None else initial), np.zeros(2)
     wall = model.force("wall")
     if wall is None or initial is not None:

@@ -36,6 +36,7 @@ class Simulation:
     """Integrates one scene's model from a given initial displacement."""
 
     def __init__(self, model: DrillstringModel, scene):
+        model = model.fresh()  # its own cut surface and controller memory
         self.model, self.scene = model, scene
         solver = scene.solver
         self.stepper = NewmarkNewton(model, scene.time.newmark_alpha, solver.newton_tolerance,
@@ -47,24 +48,26 @@ class Simulation:
                       "min_dt": np.inf, "max_dt": 0.0, "forced_steps": 0, "max_penetration": 0.0}
         self.last_state: State | None = None  # the latest accepted state (what an interrupted run keeps)
 
-    def initial_state(self, q0: np.ndarray, mu0: np.ndarray) -> State:
+    def initial_state(self, q0: np.ndarray) -> State:
         """Displacement q0 (the static equilibrium), velocity (V0, Omega) of Section 3.2, and the
-        consistent acceleration and multipliers."""
+        consistent acceleration and multipliers; the memories of the model start here."""
+        self.model.begin(0.0, q0)
         qd0 = self.model.drive_velocity_field()
-        qdd0, mu = self.stepper.initial_acceleration(q0, qd0, mu0)
+        qdd0, mu = self.stepper.initial_acceleration(q0, qd0)
         return State(0.0, q0, qd0, qdd0, mu)
 
     def _power_terms(self, state: State, ev: Evaluation) -> PowerTerms:
         return PowerTerms(
             drive=-state.mu,
             drive_displacement=self.model.constraints @ state.q,
+            drive_loads=ev.drive.generalised,
             damping=self.model.internal.damping_force(state.qd),
             laws={name: law for f in self.model.forces for name, law in ev.forces[f.name].laws.items()},
         )
 
     def mechanical_energy(self, state: State, ev: Evaluation) -> tuple[float, float, float]:
         """Kinetic, strain, and potential (of the point forces: gravity, wall springs) energies."""
-        kinetic = self.model.internal.kinetic_energy(state.q, state.qd)
+        kinetic = self.model.kinetic_energy(state.q, state.qd)
         strain = self.model.internal.strain_energy(state.q)
         return kinetic, strain, self.model.potential_energy(ev)
 
@@ -97,6 +100,7 @@ class Simulation:
             on_step(StepRecord(state, 0.0, 0, ev, np.zeros_like(in_contact), in_contact, budget, 0))
         while state.t < t_end * (1 - 1e-12):
             dt = min(self.controller.dt, t_end - state.t)
+            model.start_step(state.t + dt)
             try:
                 new, iterations, new_ev = self.stepper.step(state, dt, h0)
             except NewtonFailure as failure:
@@ -108,6 +112,7 @@ class Simulation:
             if not self.controller.judge(dt, ratio):
                 self.stats["rejected_steps"] += 1
                 continue
+            model.accept(new.t, new.q, new.qd)
             new_powers = self._power_terms(new, new_ev)
             budget.advance(powers, new_powers, new.q - state.q)
             budget.record(*self.mechanical_energy(new, new_ev))

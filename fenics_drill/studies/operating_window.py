@@ -9,6 +9,10 @@ the same N parameter draws at every point (common random numbers, so that the ma
 compares operating points and not samples); objective E[objective] (102); admissible
 where the estimate of P{UTS - max sigma_VM >= 0} is >= 1 - P_risk (103)-(104).
 
+Every point also gets the stick-slip map's indicators (:data:`OSCILLATIONS`, over the second half of
+its run): stick-slip severity (max - min) omega_bit / 2 Omega, the fraction of time stuck, and the
+fraction off the bottom; ``smooth_drilling`` marks where the bit neither sticks nor bounces off.
+
 Work is spread over MPI ranks by (point, realisation) pairs, each result written at
 once to ``DIR/points/PPPP_KKKK.json`` (atomically); ``--resume`` skips those present,
 exactly like ``fenics-drill mc``.  Rank 0 assembles ``DIR/optimize.json``.
@@ -36,6 +40,9 @@ from fenics_drill.studies.uncertainty import BitRockLaws
 
 NOMINAL_DRAW = -1
 
+#: The stick-slip map's indicators of a run, over its second half (:mod:`fenics_drill.studies.prepare`).
+OSCILLATIONS = ("stick_slip_severity", "stick_fraction", "off_bottom_fraction")
+
 
 def grid_axis(spec: list) -> np.ndarray:
     low, high, n = spec
@@ -57,6 +64,7 @@ def _evaluate(prepared, scene, v0: float, omega: float, bit_rock: dict) -> dict:
     r = run_realisation(prepared, point_scene)
     return {"status": r["status"], "message": r["message"], "rop": r["rop"], "signed_rop": r["signed_rop"],
             "efficiency": r["efficiency"], "max_von_mises": r["max_von_mises"], "bit_rock": bit_rock,
+            **{key: r[key] for key in OSCILLATIONS},
             "wall_time_s": r["wall_time_s"]}
 
 
@@ -85,7 +93,7 @@ def assemble(scene, out: Path) -> dict:
     draws = [NOMINAL_DRAW] if opt.samples == 0 else list(range(opt.samples))
     shape = (len(v0), len(omega))
     maps = {key: np.full(shape, np.nan) for key in ("rop", "signed_rop", "efficiency", "max_von_mises",
-                                                     "constraint_probability")}
+                                                     "constraint_probability", *OSCILLATIONS)}
     failed = 0
     for i in range(len(v0)):
         for j in range(len(omega)):
@@ -94,8 +102,9 @@ def assemble(scene, out: Path) -> dict:
             failed += len(results) - len(finished)
             if not finished:
                 continue
-            for key in ("rop", "signed_rop", "efficiency"):
-                maps[key][i, j] = np.mean([r[key] for r in finished])  # E[.] of (102); the value itself if N = 0
+            for key in ("rop", "signed_rop", "efficiency", *OSCILLATIONS):
+                # E[.] of (102); the value itself if N = 0 (results of earlier versions lack the oscillations)
+                maps[key][i, j] = np.mean([r.get(key, np.nan) for r in finished])
             stresses = np.array([r["max_von_mises"] for r in finished])
             maps["max_von_mises"][i, j] = stresses.max()
             maps["constraint_probability"][i, j] = chance_constraint(stresses, opt.ultimate_strength,
@@ -112,6 +121,8 @@ def assemble(scene, out: Path) -> dict:
         "axial_velocity": v0.tolist(), "rotation_speed": omega.tolist(), "t_end": scene.time.t_end,
         **{key: value.tolist() for key, value in maps.items()},
         "admissible": admissible.tolist(), "failed_runs": failed,
+        # the stick-slip map: where the bit neither sticks nor leaves the bottom in the second half of the run
+        "smooth_drilling": ((maps["stick_fraction"] == 0) & (maps["off_bottom_fraction"] == 0)).tolist(),
     }
     if np.isfinite(candidates).any():
         i, j = np.unravel_index(int(np.argmax(candidates)), shape)

@@ -19,7 +19,7 @@ import numpy as np
 from fenics_drill.model.drillstring import DrillstringModel, build_model
 from fenics_drill.model.enrichment import missed_share
 from fenics_drill.model.spaces import ModalSpace
-from fenics_drill.observables.drilling_quantities import drilling_quantities
+from fenics_drill.observables.drilling_quantities import bit_bounce, drilling_quantities, stick_slip
 from fenics_drill.observables.step_rows import StepRows
 from fenics_drill.solvers.static import StaticEquilibrium, StaticFailure, solve_static, static_report
 from fenics_drill.solvers.step_control import StepTooSmall
@@ -70,12 +70,12 @@ def _with_static_state(model: DrillstringModel, tolerance: float) -> tuple[Drill
         model.guard = {**model.guard, "static_state": {"error": None, "added": False,
                                                        "message": f"full-order static state not found: {failure}"}}
         return model, None
-    stiffness, drive = model.operators.stiffness, model.constraints
-    missed = missed_share(model.space.phi, stiffness, drive, state)
+    stiffness, held = model.operators.stiffness, model.at_rest().constraints
+    missed = missed_share(model.space.phi, stiffness, held, state)
     guard = {**model.guard, "static_state": {"error_modes": missed, "added": missed > tolerance}}
     if missed > tolerance:
         model = model.with_vectors(state[:, None], guard)
-    guard["static_state"]["error"] = missed_share(model.space.phi, stiffness, model.constraints, state)
+    guard["static_state"]["error"] = missed_share(model.space.phi, stiffness, model.at_rest().constraints, state)
     model.guard = guard
     return model, state
 
@@ -108,7 +108,7 @@ def run_realisation(prepared: PreparedScene, scene) -> dict:
     model = prepared.model.with_drive(scene.drive.axial_velocity, scene.drive.rotation_speed) \
         .with_bit_rock(scene.bit_rock)
     simulation = Simulation(model, scene)
-    start = simulation.initial_state(prepared.equilibrium.q, prepared.equilibrium.mu)
+    start = simulation.initial_state(prepared.equilibrium.q)
     recorder = RealisationRecorder(model, scene)
     clock = time.perf_counter()
     status, message = "finished", "reached time.t_end"
@@ -129,6 +129,20 @@ def run_realisation(prepared: PreparedScene, scene) -> dict:
     result["signed_rop"] = q.get("signed_rop", np.nan)
     result["mean_bit_velocity"] = (series["bit_displacement"][-1] - series["bit_displacement"][0]) / t[-1] \
         if t[-1] > 0 else np.nan
+    result.update(_oscillation_indicators(series, drive.axial_velocity, drive.rotation_speed))
     stress = series["max_von_mises"]
     result["max_von_mises"] = float(np.nanmax(stress)) if np.isfinite(stress).any() else np.nan
     return result
+
+
+def _oscillation_indicators(series: dict, axial_velocity: float, rotation_speed: float) -> dict:
+    """Stick-slip severity, stuck fraction and off-bottom fraction over the second half of a run (the
+    start-up from the static state left out): what a stick-slip map shows."""
+    t = series["time"]
+    late = t >= 0.5 * t[-1]
+    if late.sum() < 2 or rotation_speed <= 0:
+        return {"stick_slip_severity": np.nan, "stick_fraction": np.nan, "off_bottom_fraction": np.nan}
+    spin = stick_slip(t[late], series["bit_angular_velocity"][late], rotation_speed)
+    bounce = bit_bounce(t[late], series["bit_velocity"][late], axial_velocity)
+    return {"stick_slip_severity": spin["stick_slip_severity"], "stick_fraction": spin["stick_fraction"],
+            "off_bottom_fraction": bounce["off_bottom_fraction"]}

@@ -148,7 +148,7 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
             summary["basis_guard"] = model.guard
             summary["setup_time_s"], summary["static"] = prepared.setup_time_s, prepared.static
             simulation = Simulation(model, scene)
-            start = simulation.initial_state(equilibrium.q, equilibrium.mu)
+            start = simulation.initial_state(equilibrium.q)
             recorder = RunRecorder(model, scene, out, on_write=running)
             u0 = model.bit_state(start.q, start.qd)[0]
             summary["nominal_dt"] = nominal_step(scene)

@@ -79,10 +79,10 @@ def test_the_budget_books_the_spring_potential_and_the_energy_is_conserved(sprin
     scene, model = spring_model
     simulation = Simulation(model, scene)
     q0 = np.zeros(model.size)
-    start = simulation.initial_state(q0, np.zeros(2))
+    start = simulation.initial_state(q0)
     tip = model.space.rows([model.disc.end_dof(U, 1)])
     start.qd = 0.1 * tip.toarray().ravel()  # the bit moves at 0.1 m/s (the full space's rows are sparse)
-    start.qdd, start.mu = simulation.stepper.initial_acceleration(q0, start.qd, np.zeros(2))
+    start.qdd, start.mu = simulation.stepper.initial_acceleration(q0, start.qd)
     simulation.run(start, 5e-3)
     budget = simulation.budget
     assert budget.potential > 0  # the spring was stretched and its energy is in the budget

@@ -26,12 +26,12 @@ def kicked_run(*overrides, t_end=0.03):
     model = build_model(scene)
     simulation = Simulation(model, scene)
     q0 = np.zeros(model.size)
-    start = simulation.initial_state(q0, np.zeros(2))
+    start = simulation.initial_state(q0)
     kick = np.zeros(model.size)
     for row in model.lateral_rows[1].toarray():  # every free vertex towards the wall at 2 m/s
         kick[np.flatnonzero(row)] = -2.0
     start.qd = start.qd + kick
-    start.qdd, start.mu = simulation.stepper.initial_acceleration(q0, start.qd, np.zeros(2))
+    start.qdd, start.mu = simulation.stepper.initial_acceleration(q0, start.qd)
     simulation.run(start, t_end)
     return model, simulation
 

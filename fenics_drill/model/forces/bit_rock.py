@@ -77,6 +77,10 @@ class BitRock:
         self.friction, self.borehole_radius = torque_sign * bit_rock.friction, borehole_radius
 
     @classmethod
+    def chosen(cls, scene) -> bool:
+        return scene.bit_rock.law == "paper"
+
+    @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "BitRock":
         return cls(disc, space, scene.bit_rock, scene.borehole.radius, LAW_SIGN[scene.law(scene.bit_rock.torque_law)])
 

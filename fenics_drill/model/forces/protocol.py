@@ -51,3 +51,20 @@ class PointForce(Protocol):
 
     def record(self, evaluation: ForceEvaluation) -> dict[str, float]:
         """The values of :attr:`recorded` at the evaluated state."""
+
+
+class ForceWithMemory(PointForce, Protocol):
+    """A force whose law depends on the history of the motion (the cutting bit's delay).
+
+    The model gives each simulation its own copy (:meth:`fresh`), starts it at the initial state
+    (:meth:`begin`) and shows it every accepted step (:meth:`accept`); rejected trial steps leave
+    no trace.  Alternative laws of one force also define ``chosen(scene) -> bool``."""
+
+    def fresh(self) -> "ForceWithMemory":
+        """A copy with an empty memory."""
+
+    def begin(self, t: float, q: np.ndarray) -> None:
+        """Start the memory at the initial state."""
+
+    def accept(self, t: float, q: np.ndarray, qd: np.ndarray) -> None:
+        """Remember an accepted state."""

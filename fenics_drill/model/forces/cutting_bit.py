@@ -1,0 +1,231 @@
+"""The cutting bit law of Richard, Germay & Detournay (2007) at x = L (``bit_rock.law = "detournay"``).
+
+The rock pushes the bit back with W >= 0 and resists its rotation with T, each a cutting part
+proportional to the depth of cut per revolution d and a frictional-contact part of the wear flats:
+
+    W = zeta eps a d + W_f,          W_f = sigma a l   (bit cutting, u_dot_bit > 0)
+    T = eps a^2 d / 2 + mu gamma a W_f / 2
+
+(Detournay & Defourny 1992; Richard, Germay & Detournay, J. Sound Vib. 305, 2007, Eqs. (1)-(4)).
+W [N], T [N m]; on the string they act as -W on u(L) and -T on theta_x(L).
+
+**The delay.**  Each of the n blades cuts the surface the previous blade left one blade passage
+(2 pi / n of the bit's own rotation) before: d = n max(0, u_bit - S(phi_bit - 2 pi / n)), where
+S(psi) = max(u_bit(psi), S(psi - 2 pi / n)) is the bottom-hole surface (:class:`CutSurface`): a
+bit off the bottom cuts nothing and leaves the surface as it was.  Before t = 0 the bit is taken
+as drilling steadily at the drive speeds (V0, Omega).
+
+**Regularisation** (scene keys ``contact_velocity`` v_c, ``contact_depth`` d_c).  The contact force
+is set-valued when the bit stops (0 <= W_f <= sigma a l) and vanishes off the bottom; here
+W_f = sigma a l clip(u_dot_bit / v_c, 0, 1) clip(d / d_c, 0, 1), and the torque opposes the spin
+through clip(omega_bit a / v_c, -1, 1).  The tangent is consistent with these piecewise-linear
+forms, including d(d)/d(phi_bit) through the surface's slope.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+import scipy.sparse as sp
+
+from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
+from fenics_drill.model.forces.protocol import ForceEvaluation
+
+
+def clip_ramp(x: float, low: float = 0.0) -> tuple[float, float]:
+    """(clip(x, low, 1), its slope)."""
+    if x <= low:
+        return low, 0.0
+    if x >= 1.0:
+        return 1.0, 0.0
+    return x, 1.0
+
+
+class CutSurface:
+    """The bottom-hole surface S against the bit angle: the delay buffer of the cutting law.
+
+    It keeps (phi_k, S_k) at the accepted steps where the bit turned further than ever before, and
+    interpolates linearly between them; entries more than two revolutions behind are dropped.
+    """
+
+    def __init__(self, blades: int, angle: float, position: float, feed_per_radian: float):
+        """Start at the bit's (angle, position) with the surface of steady drilling at ``feed_per_radian``
+        (V0 / Omega) behind it."""
+        self.passage = 2.0 * math.pi / blades
+        self.feed = feed_per_radian
+        self._angle = np.empty(1024)
+        self._surface = np.empty(1024)
+        self._angle[0], self._surface[0] = angle, position
+        self._start, self._end = 0, 1
+        self._pruned = False
+
+    @property
+    def angles(self) -> np.ndarray:
+        return self._angle[self._start:self._end]
+
+    @property
+    def surfaces(self) -> np.ndarray:
+        return self._surface[self._start:self._end]
+
+    def at(self, angle: float) -> tuple[float, float]:
+        """(S(angle), dS/dangle)."""
+        angles, surfaces = self.angles, self.surfaces
+        if angle <= angles[0]:
+            if self._pruned:
+                return float(surfaces[0]), 0.0
+            return float(surfaces[0] - (angles[0] - angle) * self.feed), self.feed  # steady drilling before t = 0
+        k = int(np.searchsorted(angles, angle))
+        if k >= len(angles):
+            return float(surfaces[-1]), 0.0
+        a0, a1, s0, s1 = angles[k - 1], angles[k], surfaces[k - 1], surfaces[k]
+        slope = (s1 - s0) / (a1 - a0)
+        return float(s0 + slope * (angle - a0)), float(slope)
+
+    def previous_pass(self, angle: float) -> tuple[float, float]:
+        """(S, dS/dangle) one blade passage behind ``angle``: what the blade at ``angle`` cuts into."""
+        return self.at(angle - self.passage)
+
+    def advance(self, angle: float, position: float) -> None:
+        """Record an accepted bit state: the blade at ``angle`` leaves max(position, the surface it met)."""
+        if angle <= self._angle[self._end - 1]:
+            return  # the bit turned back: the surface ahead is the one already recorded
+        surface = max(position, self.previous_pass(angle)[0])
+        if self._end == len(self._angle):
+            self._compact(angle)
+        self._angle[self._end], self._surface[self._end] = angle, surface
+        self._end += 1
+
+    def _compact(self, angle: float) -> None:
+        """Drop what lies more than two revolutions behind, then grow the storage if still needed."""
+        keep = max(self._start, int(np.searchsorted(self.angles, angle - 4.0 * math.pi)) + self._start - 1)
+        if keep > self._start:
+            self._pruned = True
+        n = self._end - keep
+        size = len(self._angle) if n < len(self._angle) // 2 else 2 * len(self._angle)
+        angles, surfaces = np.empty(size), np.empty(size)
+        angles[:n], surfaces[:n] = self._angle[keep:self._end], self._surface[keep:self._end]
+        self._angle, self._surface, self._start, self._end = angles, surfaces, 0, n
+
+
+@dataclass
+class CuttingForces(ForceEvaluation):
+    """The bit's state and the law's reaction (W, T >= 0 while cutting) with its derivatives."""
+
+    depth_of_cut: float = 0.0  # d per revolution [m]
+    force: float = 0.0  # -W, the force on u(L) [N]
+    torque: float = 0.0  # -T, the torque on theta_x(L) [N m]
+    jacobian_q: np.ndarray | None = None  # d(force, torque) / d(u, phi) at the bit
+    jacobian_qd: np.ndarray | None = None  # d(force, torque) / d(u_dot, omega) at the bit
+
+
+class CuttingBit:
+    """Reaction of the rock on a cutting bit (x = L): -W on u, -T on theta_x (module doc)."""
+
+    name: ClassVar[str] = "bit_rock"
+    switch: ClassVar[str] = "bit_rock"
+    conservative: ClassVar[bool] = False
+    recorded: ClassVar[dict] = {
+        "bit_force": ("N", "bit-rock force on the string at x = L (F_BR of (20), or -W of the cutting law)"),
+        "bit_torque": ("N m", "bit-rock torque on the string at x = L (T_BR of (21), or -T of the cutting law)"),
+        "depth_of_cut": ("m", "depth of cut per revolution d of the cutting law (0 for the paper's law)"),
+    }
+
+    def __init__(self, disc: BeamDiscretization, space, bit_rock, drive):
+        self.rows = space.rows([disc.end_dof(U, 1), disc.end_dof(THETA_X, 1)])  # 2 x N: q -> u(L), theta_x(L)
+        self.sparse = space.sparse
+        self._set_parameters(bit_rock)
+        self.feed_per_radian = drive.axial_velocity / drive.rotation_speed if drive.rotation_speed > 0 else 0.0
+        self.surface: CutSurface | None = None  # no rock cut before the drilling run begins
+
+    def _set_parameters(self, bit) -> None:
+        self.blades = bit.blades
+        a = bit.bit_radius
+        self.cutting = (bit.cutting_orientation * bit.specific_energy * a, bit.specific_energy * a * a / 2.0)
+        self.contact_force = bit.contact_strength * a * bit.wear_flat_length  # sigma a l
+        self.contact_torque_arm = bit.friction * bit.geometry_factor * a / 2.0  # T_f = mu gamma a W_f / 2
+        self.contact_velocity, self.contact_depth = bit.contact_velocity, bit.contact_depth
+        self.spin_scale = bit.contact_velocity / a
+
+    @classmethod
+    def chosen(cls, scene) -> bool:
+        return scene.bit_rock.law == "detournay"
+
+    @classmethod
+    def from_scene(cls, scene, disc, space, operators) -> "CuttingBit":
+        return cls(disc, space, scene.bit_rock, scene.drive)
+
+    def with_parameters(self, bit_rock) -> "CuttingBit":
+        changed = copy.copy(self)
+        changed._set_parameters(bit_rock)
+        return changed
+
+    def with_drive(self, axial_velocity: float, rotation_speed: float) -> "CuttingBit":
+        """The same law with the steady drilling before t = 0 at other drive speeds."""
+        changed = copy.copy(self)
+        changed.feed_per_radian = axial_velocity / rotation_speed if rotation_speed > 0 else 0.0
+        return changed
+
+    # --- the delay buffer's life, one per simulation -------------------------------------------------------
+
+    def fresh(self) -> "CuttingBit":
+        changed = copy.copy(self)
+        changed.surface = None
+        return changed
+
+    def _bit(self, vector: np.ndarray) -> tuple[float, float]:
+        u, phi = np.ravel(self.rows @ vector)
+        return float(u), float(phi)
+
+    def begin(self, t: float, q: np.ndarray) -> None:
+        u, phi = self._bit(q)
+        self.surface = CutSurface(self.blades, phi, u, self.feed_per_radian)
+
+    def accept(self, t: float, q: np.ndarray, qd: np.ndarray) -> None:
+        u, phi = self._bit(q)
+        self.surface.advance(phi, u)
+
+    # --- the law -------------------------------------------------------------------------------------------
+
+    def record(self, forces: CuttingForces) -> dict[str, float]:
+        return {"bit_force": forces.force, "bit_torque": forces.torque, "depth_of_cut": forces.depth_of_cut}
+
+    def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> CuttingForces:
+        (u, phi), (u_dot, omega) = self._bit(q), self._bit(qd)
+        if self.surface is None:
+            cut, slope = u, 0.0  # at rest before drilling: the bit sits on the bottom, nothing to cut
+        else:
+            cut, slope = self.surface.previous_pass(phi)
+        n = self.blades
+        cutting = u > cut
+        d = n * (u - cut) if cutting else 0.0
+        dd = np.array([n, -n * slope]) if cutting else np.zeros(2)  # d(d) / d(u, phi)
+        g_v, dg_v = clip_ramp(u_dot / self.contact_velocity)
+        g_d, dg_d = clip_ramp(d / self.contact_depth)
+        contact = self.contact_force * g_v * g_d
+        d_contact_q = self.contact_force * g_v * dg_d / self.contact_depth * dd
+        d_contact_v = self.contact_force * dg_v / self.contact_velocity * g_d
+        zeta_eps_a, eps_a2_half = self.cutting
+        weight = zeta_eps_a * d + contact
+        magnitude = eps_a2_half * d + self.contact_torque_arm * contact
+        s, ds = clip_ramp(omega / self.spin_scale, -1.0)
+        torque = magnitude * s
+        d_weight_q = zeta_eps_a * dd + d_contact_q
+        d_torque_q = (eps_a2_half * dd + self.contact_torque_arm * d_contact_q) * s
+        jac_q = -np.array([d_weight_q, d_torque_q])
+        jac_qd = -np.array([[d_contact_v, 0.0],
+                            [self.contact_torque_arm * d_contact_v * s, magnitude * ds / self.spin_scale]])
+        f_u, f_t = -weight, -torque
+        rows_u, rows_t = self.rows[[0]], self.rows[[1]]
+        laws = {"bit_rock_force": np.ravel(rows_u.T @ np.array([f_u])),
+                "bit_rock_torque": np.ravel(rows_t.T @ np.array([f_t]))}
+        generalised = laws["bit_rock_force"] + laws["bit_rock_torque"]
+        return CuttingForces(generalised, 0.0, laws, d, f_u, f_t, jac_q, jac_qd)
+
+    def tangent(self, forces: CuttingForces, c_u: float, c_v: float):
+        """c_u df/dq + c_v df/dqd: the 2 x 2 law Jacobians at the bit, projected."""
+        block = c_u * forces.jacobian_q + c_v * forces.jacobian_qd
+        return self.rows.T @ (sp.csr_matrix(block) @ self.rows) if self.sparse else self.rows.T @ block @ self.rows
