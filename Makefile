@@ -2,7 +2,7 @@
 PY := .venv/bin/python
 OUT ?= out
 
-.PHONY: setup demo demo-printed demo-as-printed test bench bench-ross campbell mc optimize clean
+.PHONY: setup demo demo-printed demo-as-printed test bench bench-ross campbell mc optimize stick-slip clean
 
 setup:
 	@bash scripts/bootstrap.sh
@@ -68,6 +68,16 @@ optimize: setup
 	$(PY) -m fenics_drill.cli plot $(OUT)/window-efficiency
 	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/window_robust.toml --out $(OUT)/window-robust --resume
 	$(PY) -m fenics_drill.cli plot $(OUT)/window-robust
+
+## Stick-slip maps of the paper's string with the cutting law, stiff drive and soft-torque top drive
+## (docs/drilling_control.md), and the linear stability of steady drilling.
+stick-slip: setup
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/stick_slip_map.toml --out $(OUT)/stick-slip-stiff --resume
+	$(PY) -m fenics_drill.cli plot $(OUT)/stick-slip-stiff
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/stick_slip_map_soft_torque.toml --out $(OUT)/stick-slip-soft --resume
+	$(PY) -m fenics_drill.cli plot $(OUT)/stick-slip-soft
+	$(PY) benchmarks/stick_slip_table.py $(OUT)/stick-slip-stiff $(OUT)/stick-slip-soft
+	$(PY) benchmarks/stick_slip_stability.py
 
 clean:
 	rm -rf $(OUT) .pytest_cache

@@ -65,6 +65,7 @@ def stick_slip_map(report: dict, v0: np.ndarray, rpm: np.ndarray, directory: Pat
     """The three oscillation indicators side by side, the smooth-drilling region outlined (white)."""
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
     smooth = np.array(report["smooth_drilling"], dtype=float)
+    failed = ~np.isfinite(np.array(report["stick_slip_severity"], dtype=float))
     for ax, (name, (label, scale)) in zip(axes, OSCILLATION_MAPS.items()):
         values = np.array(report[name], dtype=float) * scale
         levels = ax.contourf(v0, rpm, values.T, levels=15, cmap="magma")
@@ -73,7 +74,9 @@ def stick_slip_map(report: dict, v0: np.ndarray, rpm: np.ndarray, directory: Pat
             ax.contour(v0, rpm, smooth.T, levels=[0.5], colors="w", linewidths=2)
         V, W = np.meshgrid(v0, rpm, indexing="ij")
         ax.plot(V[smooth > 0], W[smooth > 0], "wo", ms=4, label="smooth drilling")
-        ax.plot(V[smooth == 0], W[smooth == 0], "cx", ms=5, label="stick-slip or bit-bounce")
+        ax.plot(V[(smooth == 0) & ~failed], W[(smooth == 0) & ~failed], "cx", ms=5, label="stick-slip or bit-bounce")
+        if failed.any():
+            ax.plot(V[failed], W[failed], "ks", ms=6, label="run failed (blank)")
         ax.set(xlabel="V0 [m/h]", ylabel="Omega [rpm]", title=label.split(" [")[0])
         ax.legend(loc="lower left", fontsize=7)
     fig.suptitle(f"stick-slip map, second half of t_end = {report['t_end']:g} s")
