@@ -59,3 +59,21 @@ def test_cli_reports_scene_errors_before_computing(tmp_path, capsys):
     assert code == 2
     assert "beam.inner_radius" in capsys.readouterr().err
     assert not (tmp_path / "modes.json").exists()
+
+
+@pytest.mark.parametrize(
+    "overrides, words",
+    [
+        (["drive.mode=hook_load", "drive.weight_on_bit=30e3"], ["drive.weight_on_bit", "30000.0", "limit_force"]),
+        (["drive.mode=hook_load", "model.bit_rock=false"], ["hook_load", "model.bit_rock"]),
+        (["bit_rock.law=detournay", "bit_rock.bit_radius=0.2"], ["bit_rock.bit_radius", "0.2", "borehole.radius"]),
+        (["drive.controller=fast"], ["drive.controller", "fast", "stiff, pi, soft_torque"]),
+    ],
+)
+def test_drives_and_bit_laws_that_cannot_work_are_refused(overrides, words):
+    """A hook load the paper's law (20) cannot hold (W >= Gamma_BR: the bit would accelerate without bound),
+    a pushed string with nothing at the bit, a bit wider than its hole."""
+    with pytest.raises(SceneError) as err:
+        load_scene(PAPER, overrides)
+    for word in words:
+        assert word in str(err.value)
