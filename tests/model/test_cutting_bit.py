@@ -34,6 +34,8 @@ def test_the_cut_surface_returns_the_position_one_blade_passage_ago():
     positions = prescribed_motion(sampled_times)[1]
     feed = 1e-3 / 2.0
     surface = CutSurface(BLADES, sampled_angles[0], positions[0], feed)
+    # before the first sample: the steady-drilling line S0 - (angle0 - angle) feed, one multiplication
+    # (the value is 8e-4 m, so 1e-15 m is round-off)
     assert surface.previous_pass(0.0)[0] == pytest.approx(-PASSAGE * feed, abs=1e-15)
     errors = []
     for k in range(1, len(sampled_angles)):
