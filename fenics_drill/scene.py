@@ -159,7 +159,7 @@ class Time:
     newmark_alpha: float = key(0.015, "alpha of Newmark's gamma = 1/2 + alpha, beta = (1/2 + gamma)^2 / 4 "
                                "(Section 4.3) [-]", lambda x: 0 <= x <= 0.5, "in [0, 0.5]")
     adaptive: bool = key(True, "refine the step where the local error estimate exceeds time.error_tolerance")
-    error_tolerance: float = _pos("admissible local error of the lateral vertex displacements per step [m]", 1e-5)
+    error_tolerance: float = _pos("admissible local error per step of the lateral vertex displacements and of the bit's axial displacement and surface arc r theta_x [m]", 1e-5)
     max_step_cuts: int = key(12, "the smallest step is dt / 2^max_step_cuts; a run needing less stops [-]",
                              lambda n: 0 <= n <= 40, "an integer in [0, 40]")
 
@@ -221,9 +221,11 @@ class Modal:
 
 @dataclass(frozen=True)
 class Reduction:
-    rule: str = key("paper", "'paper' (Section 6.3), 'band' (f* upper bounds per family), "
-                    "'count' (number of modes per family) or 'none' (full order)",
-                    choices=("paper", "band", "count", "none"))
+    rule: str = key("auto", "'auto' (flexural modes up to 5 x the spin frequency, torsional and axial ones up to "
+                    "what the time step resolves, plus the torsional modes of a stuck bit: "
+                    "fenics_drill/model/modes.py), 'paper' (Section 6.3 as printed, Table 4), 'band' (f* upper "
+                    "bounds per family), 'count' (number of modes per family) or 'none' (full order)",
+                    choices=("auto", "paper", "band", "count", "none"))
     flexural: float = _band_or_count("flexural f* upper bound ('band') or mode count ('count')")
     torsional: float = _band_or_count("torsional f* upper bound ('band') or mode count ('count')")
     axial: float = _band_or_count("axial f* upper bound ('band') or mode count ('count')")

@@ -61,6 +61,9 @@ class DrillstringModel:
         self.constraints = self.drive.constraints  # [B] of (72), k x N_red: the rows the drive holds
         self.lateral_rows = (space.rows(disc.vertex_dofs(V)), space.rows(disc.vertex_dofs(W)))
         self.bit_rows = space.rows([disc.end_dof(U, 1), disc.end_dof(THETA_X, 1)])
+        # where the step's local error is measured [m]: the lateral displacements (impacts) and, at the
+        # bit, the axial displacement and the arc r theta_x of the surface (the bit-rock law's stiff laws)
+        self.error_rows = (*self.lateral_rows, self.bit_rows[0:1], disc.properties.outer_radius * self.bit_rows[1:2])
         self.operators = operators
 
     @property
@@ -209,5 +212,5 @@ def build_model(scene) -> DrillstringModel:
     """Discretize, solve the modal problem, choose the basis and build the model of a scene."""
     disc = BeamDiscretization.from_scene(scene)
     operators = assemble_linear(disc)
-    space, basis, modes, guard = solution_space(scene, disc, operators)
+    space, basis, modes, guard, _ = solution_space(scene, disc, operators)
     return DrillstringModel(scene, disc, space, operators, basis, modes, guard)

@@ -6,7 +6,8 @@ lowest elastic modes come first; support dofs are Dirichlet rows that never ente
 spectrum.  Every mode is classified from its kinetic-energy fractions per field.
 
 Select: the modes a scene's ``reduction.rule`` keeps (the paper's Section 6.3 bands,
-Table 4; bands or counts per family; or all).  Enrichment of the kept modes lives in
+Table 4; the 'auto' bands of what the scene excites and its step resolves, with the
+torsional modes of a stuck bit; bands or counts per family; or all).  Enrichment of the kept modes lives in
 :mod:`fenics_drill.model.enrichment`, the space built on them in :mod:`fenics_drill.model.spaces`.
 """
 
@@ -19,7 +20,7 @@ import numpy as np
 from petsc4py import PETSc
 from slepc4py import SLEPc
 
-from fenics_drill.model.discretization import THETA_X, THETA_Y, THETA_Z, U, V, W, BeamDiscretization
+from fenics_drill.model.discretization import DRIVE, THETA_X, THETA_Y, THETA_Z, U, V, W, BeamDiscretization
 from fenics_drill.model.operators import assemble_linear, assemble_modal_pair, field_mass_fractions
 
 KINDS = ("rigid", "flexural", "torsional", "axial")
@@ -152,31 +153,76 @@ def paper_bands(length: float, longitudinal_wave_speed: float) -> dict[str, floa
     return {"flexural": 5.0 * length / longitudinal_wave_speed, "torsional": 4.0, "axial": 4.0}
 
 
-def select_modes(basis: ModalBasis, reduction, length: float, longitudinal_wave_speed: float) -> np.ndarray:
+#: Harmonics of the spin the 'auto' rule keeps flexural modes for (the paper keeps 5 Hz at Omega = 1 Hz).
+SPIN_HARMONICS = 5.0
+
+
+def step_band(scene) -> float:
+    """The f* up to which the scene's time step resolves the motion: f*_max of the band B with the
+    nominal step 1 / (2 f_max) of Section 6.2, or L / (2 dt c_L) with a step of the scene's own."""
+    p = scene.beam_properties
+    f_star_max = scene.modal.f_star_max
+    if scene.time.dt > 0:
+        return min(f_star_max, p.length / (2.0 * scene.time.dt * p.longitudinal_wave_speed))
+    return f_star_max
+
+
+def auto_bands(scene) -> dict[str, float]:
+    """The 'auto' rule's f* bound per family, from what the scene excites and resolves: flexural modes
+    up to SPIN_HARMONICS times the spin frequency Omega / 2 pi (the paper's 5 Hz at Omega = 2 pi rad/s),
+    torsional and axial modes up to what the time step resolves (the paper's f* = 4 at its step)."""
+    p = scene.beam_properties
+    step = step_band(scene)
+    spin_hz = abs(scene.drive.rotation_speed) / (2.0 * math.pi)
+    flexural = SPIN_HARMONICS * spin_hz * p.length / p.longitudinal_wave_speed
+    return {"flexural": min(flexural, step), "torsional": step, "axial": step}
+
+
+def reduction_bands(scene) -> dict[str, float] | None:
+    """The f* bound per family of ``reduction.rule`` ('paper', 'band', 'auto'); None for 'count', 'none'."""
+    red, p = scene.reduction, scene.beam_properties
+    if red.rule == "paper":
+        return paper_bands(p.length, p.longitudinal_wave_speed)
+    if red.rule == "band":
+        return {f: getattr(red, f) for f in FAMILIES}
+    if red.rule == "auto":
+        return auto_bands(scene)
+    return None
+
+
+def select_modes(basis: ModalBasis, scene) -> np.ndarray:
     """Indices of the modes kept by ``reduction.rule`` (always including the rigid modes).
 
-    'paper': the printed Section 6.3 bands; 'band': ``reduction.<family>`` is
-    the f* upper bound per family; 'count': ``reduction.<family>`` is the number of
-    lowest modes kept per family; 'none': every mode (the full model uses no basis).
+    'paper': the printed Section 6.3 bands; 'auto': :func:`auto_bands`; 'band': ``reduction.<family>``
+    is the f* upper bound per family; 'count': ``reduction.<family>`` is the number of lowest modes kept
+    per family; 'none': every mode (the full model uses no basis).
     """
-    rule = reduction.rule
+    reduction = scene.reduction
     kinds = np.array(basis.kinds)
     keep = kinds == "rigid"
-    if rule == "none":
+    if reduction.rule == "none":
         return np.arange(len(basis))
-    if rule in ("paper", "band"):
-        bands = paper_bands(length, longitudinal_wave_speed) if rule == "paper" else {
-            f: getattr(reduction, f) for f in FAMILIES
-        }
-        for family in FAMILIES:
-            keep |= (kinds == family) & (basis.f_star > 0) & (basis.f_star <= bands[family])
-    elif rule == "count":
+    if reduction.rule == "count":
         for family in FAMILIES:
             members = np.flatnonzero(kinds == family)[: int(getattr(reduction, family))]
             keep[members] = True
-    else:
-        raise ValueError(f"unknown reduction rule {rule!r}")
+        return np.flatnonzero(keep)
+    bands = reduction_bands(scene)
+    if bands is None:
+        raise ValueError(f"unknown reduction rule {reduction.rule!r}")
+    for family in FAMILIES:
+        keep |= (kinds == family) & (basis.f_star > 0) & (basis.f_star <= bands[family])
     return np.flatnonzero(keep)
+
+
+def stuck_bit_modes(disc: BeamDiscretization, f_star_max: float, mass) -> ModalBasis:
+    """Torsional modes of the string held by the drive and stuck at the bit (theta_x(L) held too): the
+    fixed-fixed waves n c_T / 2L that ring while the bit sticks (stick-slip, Section 6.9).  The modes of
+    the free bit alone reach the bit's stuck state only through many of them; with these, the basis
+    spans both phases, as the fixed-interface modes of Craig & Bampton (1968) with the static bit
+    responses of the guard as constraint modes."""
+    modes = solve_modes(disc, f_star_max, mass, held=(*DRIVE, (THETA_X, 1)))
+    return modes.select(np.flatnonzero(np.array(modes.kinds) == "torsional"))
 
 
 def family_counts(kinds) -> dict[str, int]:

@@ -20,8 +20,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
-from fenics_drill.model.enrichment import enrich
-from fenics_drill.model.modes import ModalBasis, select_modes, solve_modes
+from fenics_drill.model.enrichment import augment, enrich
+from fenics_drill.model.modes import ModalBasis, reduction_bands, select_modes, solve_modes, stuck_bit_modes
 from fenics_drill.model.operators import LinearOperators
 
 
@@ -135,16 +135,20 @@ class BasisError(ValueError):
 
 
 def solution_space(scene, disc: BeamDiscretization, operators: LinearOperators):
-    """(space, kept modes, all modes, guard report): the modal basis of the scene's reduction rule
-    (Section 6.3) checked and enriched by the guard (:mod:`fenics_drill.model.enrichment`), or the
-    full space for 'none'; all modes of the band B (for spectra) either way."""
-    p = disc.properties
+    """(space, kept modes, all modes, guard report, stuck-bit modes): the modal basis of the scene's
+    reduction rule (Section 6.3), with the 'auto' rule's torsional modes of a stuck bit (None otherwise),
+    checked and enriched by the guard (:mod:`fenics_drill.model.enrichment`), or the full space for
+    'none'; all modes of the band B (for spectra) either way."""
     modes = solve_modes(disc, scene.modal.f_star_max, operators.mass)
     if scene.reduction.rule == "none":
-        return FullSpace(disc.ndofs, disc.support_dofs), None, modes, {}
-    basis = modes.select(select_modes(modes, scene.reduction, p.length, p.longitudinal_wave_speed))
+        return FullSpace(disc.ndofs, disc.support_dofs), None, modes, {}, None
+    basis = modes.select(select_modes(modes, scene))
+    vectors, stuck = basis.vectors, None
+    if scene.reduction.rule == "auto" and scene.model.bit_rock:
+        stuck = stuck_bit_modes(disc, reduction_bands(scene)["torsional"], operators.mass)
+        vectors = augment(vectors, stuck.vectors, operators.mass)
     drive = [disc.end_dof(U, 0), disc.end_dof(THETA_X, 0)]
-    phi, guard = enrich(basis.vectors, scene, disc, operators, lambda phi: phi[drive])
+    phi, guard = enrich(vectors, scene, disc, operators, lambda phi: phi[drive])
     tolerance = scene.reduction.guard_tolerance
     for load, verdict in guard.items():
         if verdict["error"] > tolerance:
@@ -153,4 +157,4 @@ def solution_space(scene, disc: BeamDiscretization, operators: LinearOperators):
                 f"static response to {load.replace('_', ' ')} (reduction.guard_tolerance = {tolerance:g}): set "
                 "reduction.enrich = true to add it, widen the band (reduction.rule = 'band'), or use the full "
                 "order (reduction.rule = 'none')")
-    return ModalSpace(phi), basis, modes, guard
+    return ModalSpace(phi), basis, modes, guard, stuck

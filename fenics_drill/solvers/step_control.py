@@ -1,10 +1,14 @@
-"""Time-step control: nominal step of Section 6.2, refined where impacts make the motion rough.
+"""Time-step control: nominal step of Section 6.2, refined where impacts or the bit make the motion rough.
 
 The local error of a Newmark step is estimated as in Zienkiewicz & Xie (1991):
-e = (beta - 1/6) dt^2 (qdd_{n+1} - qdd_n), measured on the lateral displacements of
-the vertices (where impacts act) against ``time.error_tolerance``.  An impact
-makes the acceleration jump, the estimate grows and the step shrinks; once the
-motion is smooth again the step relaxes back to the nominal one.  A Newton
+e = (beta - 1/6) dt^2 (qdd_{n+1} - qdd_n), measured against ``time.error_tolerance`` on
+the lateral displacements of the vertices (where impacts act) and, at the bit, on the
+axial displacement and the arc r theta_x of the pipe's surface (where the stiff
+bit-rock laws (20)-(21) act: the start-up from rest onto the rock and each stick-slip
+transition).  An impact or a bit transient makes the acceleration jump, the estimate
+grows and the step shrinks; once the motion is smooth again the step relaxes back to
+the nominal one.  Without the bit's rows a reduced model takes the start-up in one
+nominal step, and its bit velocity rings (benchmarks/reduced_accuracy.md).  A Newton
 failure halves the step; after ``time.max_step_cuts`` halvings the run stops.
 """
 
@@ -31,13 +35,13 @@ class StepController:
 
     GROWTH_MAX, SHRINK_MIN, SAFETY = 2.0, 0.25, 0.9
 
-    def __init__(self, scene, beta: float, lateral_rows):
+    def __init__(self, scene, beta: float, error_rows):
         self.nominal = nominal_step(scene)
         self.minimum = self.nominal / 2 ** scene.time.max_step_cuts
         self.adaptive = scene.time.adaptive
         self.tolerance = scene.time.error_tolerance
         self.error_factor = abs(beta - 1.0 / 6.0)
-        self.lateral_rows = lateral_rows
+        self.error_rows = error_rows  # maps of q to the displacements [m] the error is measured on
         self.dt = self.nominal
         self.forced_steps = 0  # steps accepted at the minimum size although their error exceeded the tolerance
         self.worst_forced_ratio = 0.0
@@ -45,7 +49,7 @@ class StepController:
     def error_ratio(self, dt: float, qdd_old: np.ndarray, qdd_new: np.ndarray) -> float:
         """Estimated local error over the tolerance (<= 1: accept)."""
         e = self.error_factor * dt * dt * (qdd_new - qdd_old)
-        return max(float(np.max(np.abs(rows @ e))) for rows in self.lateral_rows) / self.tolerance
+        return max(float(np.max(np.abs(rows @ e))) for rows in self.error_rows) / self.tolerance
 
     def judge(self, dt: float, ratio: float) -> bool:
         """Accept or reject a converged step and set the next proposal.  A step already at the minimum

@@ -41,7 +41,7 @@ class Simulation:
         solver = scene.solver
         self.stepper = NewmarkNewton(model, scene.time.newmark_alpha, solver.newton_tolerance,
                                      solver.newton_max_iterations, solver.tangent_reuse)
-        self.controller = StepController(scene, self.stepper.beta, model.lateral_rows)
+        self.controller = StepController(scene, self.stepper.beta, model.error_rows)
         n_vertices = len(model.disc.vertex_x)
         self.impacts_per_vertex = np.zeros(n_vertices, dtype=np.int64)
         self.stats = {"steps": 0, "rejected_steps": 0, "newton_failures": 0, "newton_iterations": 0,

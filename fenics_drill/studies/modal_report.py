@@ -16,12 +16,12 @@ from fenics_drill.studies.lifecycle import command_output
 
 def modal_report(scene) -> dict:
     """full_dofs, every mode (frequency_hz, f_star, kind, energy fractions), the reduced basis (the modes
-    the rule keeps, Table 4, and the vectors the guard adds) and the guard's report."""
+    the rule keeps, Table 4, the 'auto' rule's stuck-bit torsional modes, and the vectors the guard
+    adds) and the guard's report."""
     disc = BeamDiscretization.from_scene(scene)
     operators = assemble_linear(disc)
-    space, _, basis, guard = solution_space(scene, disc, operators)
-    p = disc.properties
-    kept = [int(i) for i in select_modes(basis, scene.reduction, p.length, p.longitudinal_wave_speed)]
+    space, _, basis, guard, stuck = solution_space(scene, disc, operators)
+    kept = [int(i) for i in select_modes(basis, scene)]
     modes = [
         {
             "frequency_hz": float(f),
@@ -36,7 +36,8 @@ def modal_report(scene) -> dict:
         "size": len(kept),
         "counts": family_counts(basis.kinds[i] for i in kept),
         "mode_indices": kept,
-        "enrichment_vectors": space.size - len(kept),
+        "stuck_bit_modes_hz": [] if stuck is None else [float(f) for f in stuck.frequencies_hz],
+        "enrichment_vectors": space.size - len(kept) - (0 if stuck is None else len(stuck)),
         "unknowns": space.size,
         "guard": guard,
     }

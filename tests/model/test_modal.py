@@ -7,7 +7,7 @@ import pytest
 from conftest import scene_with
 
 from fenics_drill.model.discretization import DRIVE, BeamDiscretization
-from fenics_drill.model.modes import solve_modes
+from fenics_drill.model.modes import auto_bands, paper_bands, solve_modes, stuck_bit_modes
 from fenics_drill.model.operators import assemble_linear
 from fenics_drill.studies.modal_report import modal_report
 
@@ -101,6 +101,34 @@ def test_modes_held_by_the_drive_are_the_fixed_free_quarter_waves():
     assert held.frequencies_hz[kinds == "torsional"][0] == pytest.approx(7.28, abs=0.01)
 
 
+def test_modes_of_a_stuck_bit_are_the_fixed_fixed_torsional_waves():
+    """With theta_x held at both ends (the drive, and the bit stuck in the rock), the torsional modes are
+    those of a shaft fixed at both ends: f_n = n c_T / (2L), every one up to the band."""
+    scene = scene_with("beam.elements=300")
+    disc = BeamDiscretization.from_scene(scene)
+    p = disc.properties
+    stuck = stuck_bit_modes(disc, 2.2, assemble_linear(disc).mass)
+    c_T = math.sqrt(p.shear_factor * p.shear_modulus / p.density)
+    n = np.arange(1, len(stuck) + 1)
+    assert set(stuck.kinds) == {"torsional"}
+    assert len(stuck) == int(2 * 2.2 * p.longitudinal_wave_speed / c_T)  # n c_T / (2 c_L) <= 2.2
+    # theta_x linear: relative error (kh)^2 / 24 <= 2.6e-4 up to k = 15 pi / 2L, h = L / 300 (as above)
+    np.testing.assert_allclose(stuck.frequencies_hz, n * c_T / (2 * p.length), rtol=5e-4)
+
+
+def test_auto_bands_are_the_paper_bands_at_the_paper_spin_and_step_and_follow_them():
+    """The 'auto' rule reads the paper's Section 6.3 off the scene: at Omega = 2 pi rad/s and the nominal
+    step its bands are the printed ones; the flexural band scales with the spin, the others with 1/dt."""
+    scene = scene_with()
+    p = scene.beam_properties
+    assert auto_bands(scene) == pytest.approx(paper_bands(p.length, p.longitudinal_wave_speed), rel=1e-12)
+    faster = auto_bands(scene_with("drive.rotation_speed=12.566370614359172"))  # 2 Hz
+    assert faster["flexural"] == pytest.approx(10.0 * p.length / p.longitudinal_wave_speed, rel=1e-12)
+    nominal_dt = p.length / (2 * 4.0 * p.longitudinal_wave_speed)  # 1 / (2 f_max), Section 6.2
+    finer = auto_bands(scene_with(f"time.dt={2 * nominal_dt}", "modal.f_star_max=4.0"))
+    assert finer["torsional"] == finer["axial"] == pytest.approx(2.0, rel=1e-12)
+
+
 def test_two_rigid_body_modes(slender_modes):
     _, basis = slender_modes
     kinds = np.array(basis.kinds)
@@ -165,7 +193,7 @@ def test_eigenvalue_convergence_rate(degree, rate):
 
 @pytest.fixture(scope="module")
 def paper_report():
-    return modal_report(scene_with("beam.elements=500"))  # the paper's mesh (Section 6)
+    return modal_report(scene_with("beam.elements=500", "reduction.rule='paper'"))  # the paper's mesh (Section 6)
 
 
 def test_paper_flexural_frequencies_of_section_6_8(paper_report):
