@@ -15,7 +15,6 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
-import scipy.sparse as sp
 
 from fenics_drill.model.discretization import THETA_X as TX_FIELD
 from fenics_drill.model.discretization import U as U_FIELD
@@ -25,6 +24,8 @@ from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
 from fenics_drill.model.spaces import weighted_product
 from fenics_drill.scene import LAW_SIGN
+
+FIELDS = (U_FIELD, V_FIELD, W_FIELD, TX_FIELD)  # the fields the wall acts on: F_a, F_v, F_w, T_FS
 
 
 def indentation(v, w, gap):
@@ -103,7 +104,10 @@ class WallContact:
         self.mu_axial = law_sign[0] * contact.friction
         self.mu_torque = law_sign[1] * contact.friction
         self.v_s = contact.sliding_velocity_scale
-        self.rows = {f: space.rows(disc.vertex_dofs(f)) for f in (U_FIELD, V_FIELD, W_FIELD, TX_FIELD)}
+        self.rows = {f: space.rows(disc.vertex_dofs(f)) for f in FIELDS}
+        # dense [Phi]: the four rows of each vertex side by side (n_vertices, 4, N_red), so the contact
+        # set's rows are one gather and the tangent one batched product (sparse spaces keep the dict)
+        self.stacked = None if space.sparse else np.stack([self.rows[f] for f in FIELDS], axis=1)
 
     @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "WallContact":
@@ -134,7 +138,11 @@ class WallContact:
             empty = np.zeros(0)
             laws = dict.fromkeys(("wall_damper", "wall_axial_friction", "wall_friction_torque"), zero)
             return WallForces(zero, 0.0, laws, delta, delta > 0, empty, empty, empty, {} if with_tangent else None)
-        rows = {f: r[f][active] for f in r}
+        if self.stacked is None:
+            block, rows = None, {f: r[f][active] for f in r}
+        else:
+            block = self.stacked[active]
+            rows = {f: block[:, k] for k, f in enumerate(FIELDS)}
         va, wa = v[active], w[active]
         dv, dw = rows[V_FIELD] @ qd, rows[W_FIELD] @ qd
         du, dtx = rows[U_FIELD] @ qd, rows[TX_FIELD] @ qd
@@ -156,6 +164,7 @@ class WallContact:
         out = WallForces(generalised, potential, laws, delta, delta > 0, normal, axial, torque)
         if with_tangent:
             out.derivatives = self._derivatives(rows, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal)
+            out.derivatives["block"] = block
         return out
 
     def _derivatives(self, rows, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal) -> dict:
@@ -193,24 +202,19 @@ class WallContact:
         sum over (out, in) of rows_out^T diag(c_u w_pos + c_v w_vel) rows_in."""
         if not forces.derivatives:
             return None
-        rows = forces.derivatives["rows"]
+        rows, block = forces.derivatives["rows"], forces.derivatives["block"]
         position, velocity = forces.derivatives["position"], forces.derivatives["velocity"]
-        weights: dict = {}
-        for scale, block in ((c_u, position), (c_v, velocity)):
-            for pair, w in block.items():
-                weights[pair] = weights.get(pair, 0.0) + scale * w
-        if sp.issparse(rows[U_FIELD]):
-            terms = (weighted_product(rows[out], w, rows[inp]) for (out, inp), w in weights.items())
-            return sum(terms)
-        # dense [Phi]: combine the inputs first, then one product per output field
-        total = None
-        for out in (U_FIELD, V_FIELD, W_FIELD, TX_FIELD):
-            combined = None
-            for (o, inp), w in weights.items():
-                if o == out:
-                    term = w[:, None] * rows[inp]
-                    combined = term if combined is None else combined + term
-            if combined is not None:
-                product = rows[out].T @ combined
-                total = product if total is None else total + product
-        return total
+        if block is None:  # sparse rows (the full order)
+            weights: dict = {}
+            for scale, derivatives in ((c_u, position), (c_v, velocity)):
+                for pair, w in derivatives.items():
+                    weights[pair] = weights.get(pair, 0.0) + scale * w
+            return sum(weighted_product(rows[out], w, rows[inp]) for (out, inp), w in weights.items())
+        # dense [Phi]: per vertex a 4 x 4 block of derivatives; sum_i R_i^T A_i R_i as one product
+        n, size = block.shape[0], block.shape[2]
+        index = {f: k for k, f in enumerate(FIELDS)}
+        weights = np.zeros((n, 4, 4))
+        for scale, derivatives in ((c_u, position), (c_v, velocity)):
+            for (out, inp), w in derivatives.items():
+                weights[:, index[out], index[inp]] += scale * w
+        return block.reshape(n * 4, size).T @ np.matmul(weights, block).reshape(n * 4, size)
