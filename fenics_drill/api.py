@@ -54,7 +54,7 @@ def static_state(scene: Scene, out: str | Path | None = None, overwrite: bool = 
     static.xdmf there."""
     if out is not None:
         return run_static(scene, out, overwrite=overwrite)
-    return prepare(scene).static
+    return prepare(scene, dynamics=False).static
 
 
 def run(scene: Scene, out: str | Path | None = None, progress: bool = False, overwrite: bool = False) -> RunResult:

@@ -236,6 +236,12 @@ class Reduction:
                                  "each load's response: off by default, the static state carries the large "
                                  "deflections and the companions spoil the bit dynamics (benchmarks/"
                                  "reduced_accuracy.md)")
+    hyper: bool = key(True, "evaluate the nonlinear internal forces (48)-(49) of a modal basis on a weighted sample of "
+                      "elements (ECSW, fenics_drill/model/hyper_reduction.py), trained on a short run of the "
+                      "unsampled model; false: on every element")
+    hyper_tolerance: float = key(1e-4, "relative error of the sampled projected nonlinear forces on the training "
+                                 "states [-]", lambda x: 0 < x < 1, "in (0, 1)")
+    hyper_training: float = _pos("simulated time of the training run of the element sample [s]", 0.1)
     guard_tolerance: float = key(0.03, "largest admissible share of a load's static response the basis may miss "
                                  "(square root of the missed strain-energy share; 0.03 = 0.1 % of the energy); 1 "
                                  "accepts any basis (the paper's pure modal basis with enrich = false)",

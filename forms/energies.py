@@ -130,17 +130,19 @@ def dissipation_density(p: BeamProperties, V):
 
 
 def inertial_force(p: BeamProperties, psi, U, V, A, dx, inertial_nonlinearity: bool = True,
-                   angular_velocity_form: str = "consistent"):
-    """Lagrange's d/dt dT/dV - dT/dU as a linear form in psi (= M(psi, A) - F_KE(psi), Eqs. 44, 48)."""
-    T = kinetic_energy_density(p, U, V, inertial_nonlinearity, angular_velocity_form) * dx
+                   angular_velocity_form: str = "consistent", weight=1.0):
+    """Lagrange's d/dt dT/dV - dT/dU as a linear form in psi (= M(psi, A) - F_KE(psi), Eqs. 44, 48);
+    ``weight`` multiplies the energy density (the element weights of a hyper-reduced sample)."""
+    T = weight * kinetic_energy_density(p, U, V, inertial_nonlinearity, angular_velocity_form) * dx
     momentum = ufl.derivative(T, V, psi)
     return ufl.derivative(momentum, U, V) + ufl.derivative(momentum, V, A) - ufl.derivative(T, U, psi)
 
 
-def elastic_force(p: BeamProperties, psi, U, dx, geometric_nonlinearity: bool = True, kinematics: str = "objective"):
-    """dV/dU [psi] (= K(psi, U) - F_SE(psi), Eqs. 46, 49)."""
+def elastic_force(p: BeamProperties, psi, U, dx, geometric_nonlinearity: bool = True, kinematics: str = "objective",
+                  weight=1.0):
+    """dV/dU [psi] (= K(psi, U) - F_SE(psi), Eqs. 46, 49); ``weight`` as for :func:`inertial_force`."""
     W = strain_energy_density(p, strain_slots(U), geometric_nonlinearity, kinematics)
-    return ufl.derivative(W * dx, U, psi)
+    return ufl.derivative(weight * W * dx, U, psi)
 
 
 def damping_force(p: BeamProperties, psi, V, dx):

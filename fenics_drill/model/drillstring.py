@@ -19,13 +19,14 @@ new models that share the expensive parts (space, operators, internal force).
 from __future__ import annotations
 
 import copy
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from fenics_drill.model.discretization import THETA_X, U, V, W, BeamDiscretization
 from fenics_drill.model.forces import ForceEvaluation, build_forces
-from fenics_drill.model.internal_force import internal_force
+from fenics_drill.model.internal_force import ElementSample, internal_force
 from fenics_drill.model.operators import LinearOperators, assemble_linear
 from fenics_drill.model.enrichment import augment
 from fenics_drill.model.spaces import FullSpace, ModalSpace, solution_space
@@ -34,15 +35,23 @@ from fenics_drill.model.top_drive import DriveLoads, TopDrive
 
 @dataclass
 class Evaluation:
-    """Residual of (65)+(72) at one state, its pieces and (optionally) its tangent."""
+    """Residual of (65)+(72) at one state, its pieces and (optionally) its tangent, which is
+    computed on first use: Newton never asks for the tangent of the state it converges to."""
 
     residual: np.ndarray
     internal: np.ndarray
     external: np.ndarray
     forces: dict[str, ForceEvaluation] = field(default_factory=dict)  # by force name
     drive: DriveLoads | None = None
-    tangent: object = None
+    tangent_of: Callable | None = None
     internal_parts: tuple | None = None
+    _tangent: object = None
+
+    @property
+    def tangent(self):
+        if self._tangent is None and self.tangent_of is not None:
+            self._tangent = self.tangent_of()
+        return self._tangent
 
 
 class DrillstringModel:
@@ -65,6 +74,7 @@ class DrillstringModel:
         # bit, the axial displacement and the arc r theta_x of the surface (the bit-rock law's stiff laws)
         self.error_rows = (*self.lateral_rows, self.bit_rows[0:1], disc.properties.outer_radius * self.bit_rows[1:2])
         self.operators = operators
+        self.exact_internal, self.hyper_reduction = None, None  # set by with_sample
 
     @property
     def size(self) -> int:
@@ -149,6 +159,16 @@ class DrillstringModel:
         return DrillstringModel(self.scene, self.disc, ModalSpace(phi), self.operators, self.basis, self.modes,
                                 guard)
 
+    def with_sample(self, sample: ElementSample, report: dict) -> "DrillstringModel":
+        """A model whose nonlinear internal forces are evaluated on an element sample (ECSW,
+        :mod:`fenics_drill.model.hyper_reduction`); the unsampled forces stay as ``exact_internal``, the
+        reference of the error indicator, and ``report`` says how the sample was trained."""
+        model = copy.copy(self)
+        model.exact_internal = self.internal
+        model.internal = internal_force(self.disc, self.space, self.operators, self.scene.model, sample)
+        model.hyper_reduction = dict(report)
+        return model
+
     def drive_velocity_field(self) -> np.ndarray:
         """Initial velocity of Section 3.2 in reduced coordinates: u_dot = V0, theta_x_dot = Omega,
         projected with the mass as in (54) (exact: both are rigid-body motions)."""
@@ -176,20 +196,24 @@ class DrillstringModel:
         residual = internal - external + self.constraints.T @ mu
         out = Evaluation(residual, internal, external, evaluations, drive)
         if want:
-            c_u, c_v, c_a = tangent_coefficients
             needed = tuple(c != 0 for c in tangent_coefficients)
             parts = internal_parts if internal_parts is not None else self.internal.tangent_parts(needed)
             out.internal_parts = parts if all(p is not None for p in parts) else None  # reusable only if whole
-            J = sum(c * part for c, part in zip(tangent_coefficients, parts) if c != 0)
-            inertia = self.drive.inertia_tangent(c_a)
-            if inertia is not None:
-                J = J + inertia
-            load_tangents = [force.tangent(evaluations[force.name], c_u, c_v) for force in self.forces]
-            for load_tangent in [*load_tangents, self.drive.tangent(drive, c_u, c_v)]:
-                if load_tangent is not None:
-                    J = J - load_tangent
-            out.tangent = J
+            out.tangent_of = lambda: self._tangent(tangent_coefficients, parts, evaluations, drive)
         return out
+
+    def _tangent(self, coefficients, internal_parts, evaluations, drive):
+        """c_u dr/dq + c_v dr/dqd + c_a dr/dqdd of the residual of :meth:`evaluate`."""
+        c_u, c_v, c_a = coefficients
+        J = sum(c * part for c, part in zip(coefficients, internal_parts) if c != 0)
+        inertia = self.drive.inertia_tangent(c_a)
+        if inertia is not None:
+            J = J + inertia
+        load_tangents = [force.tangent(evaluations[force.name], c_u, c_v) for force in self.forces]
+        for load_tangent in [*load_tangents, self.drive.tangent(drive, c_u, c_v)]:
+            if load_tangent is not None:
+                J = J - load_tangent
+        return J
 
     def kinetic_energy(self, q, qd) -> float:
         """Kinetic energy (24) of the string plus that of the top drive."""

@@ -15,10 +15,13 @@ so a change of step size needs no re-assembly.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import dolfinx.fem.petsc as fem_petsc
 import numpy as np
 import ufl
 from dolfinx import fem
+from dolfinx.mesh import meshtags
 from petsc4py import PETSc
 
 from fenics_drill.forms import energies
@@ -54,24 +57,66 @@ class LinearInternalForce:
         return self.damping @ qd
 
 
+@dataclass(frozen=True)
+class ElementSample:
+    """A reduced quadrature over the elements: the cells evaluated and their weights (ECSW,
+    :mod:`fenics_drill.model.hyper_reduction`)."""
+
+    cells: np.ndarray
+    weights: np.ndarray
+
+
 class AssembledInternalForce:
-    """Inertial (24), damping (38) and elastic (30) forces assembled from their energies."""
+    """Inertial (24), damping (38) and elastic (30) forces assembled from their energies.
+
+    With an :class:`ElementSample` (a modal space only), the linear part M a + C v + K u is applied
+    with projected matrices and only the nonlinear remainder (-F_KE - F_SE, Eqs. 48-49) is assembled,
+    on the sampled cells with their weights: the weighted sum of the element energies, so the forces
+    stay the gradients of an energy and the budget still closes (Farhat et al. 2014).
+    """
 
     def __init__(self, disc: BeamDiscretization, space, operators: LinearOperators,
                  geometric_nonlinearity: bool, inertial_nonlinearity: bool, kinematics: str = "objective",
-                 angular_velocity: str = "consistent"):
-        self.space = space
+                 angular_velocity: str = "consistent", sample: ElementSample | None = None):
+        self.space, self.sample = space, sample
+        self.switches = (geometric_nonlinearity, inertial_nonlinearity, kinematics, angular_velocity)
         p = disc.properties
         # Energies are polynomials of degree <= 4 in the fields up to sin/cos(theta_x):
         # 2k integrates the mass exactly for v, w of degree k and keeps the kernels small.
-        dx = ufl.Measure("dx", domain=disc.mesh, metadata={"quadrature_degree": 2 * disc.element_degree})
+        metadata = {"quadrature_degree": 2 * disc.element_degree}
         self.U, self.V, self.A = (fem.Function(disc.V) for _ in range(3))
         psi, dU = ufl.TestFunction(disc.V), ufl.TrialFunction(disc.V)
-        residual = (
-            energies.inertial_force(p, psi, self.U, self.V, self.A, dx, inertial_nonlinearity, angular_velocity)
-            + energies.damping_force(p, psi, self.V, dx)
-            + energies.elastic_force(p, psi, self.U, dx, geometric_nonlinearity, kinematics)
-        )
+        if sample is None:
+            dx, weight, self.dofs = ufl.Measure("dx", domain=disc.mesh, metadata=metadata), 1.0, None
+        else:
+            cells = np.asarray(sample.cells, dtype=np.int32)
+            tags = meshtags(disc.mesh, disc.mesh.topology.dim, cells, np.ones_like(cells))
+            dx = ufl.Measure("dx", domain=disc.mesh, subdomain_data=tags, metadata=metadata)(1)
+            weight = fem.Function(fem.functionspace(disc.mesh, ("DG", 0)))
+            weight.x.array[cells] = sample.weights
+            self.weight = weight
+            self.dofs = np.unique(disc.V.dofmap.list[cells])  # the dofs the sampled cells touch
+            self.phi_rows = space.phi[self.dofs]
+
+        def forces(geometric, inertial):
+            return (energies.inertial_force(p, psi, self.U, self.V, self.A, dx, inertial, angular_velocity, weight)
+                    + energies.elastic_force(p, psi, self.U, dx, geometric, kinematics, weight))
+
+        def energy(density, linear_density):
+            return weight * (density - linear_density if sample is not None else density) * dx
+
+        residual = forces(geometric_nonlinearity, inertial_nonlinearity)
+        kinetic = energies.kinetic_energy_density(p, self.U, self.V, inertial_nonlinearity, angular_velocity)
+        strain = energies.strain_energy_density(p, energies.strain_slots(self.U), geometric_nonlinearity, kinematics)
+        if sample is None:
+            residual = residual + energies.damping_force(p, psi, self.V, dx)
+        else:  # the nonlinear remainder; the linear part is applied with the projected matrices below
+            residual = residual - forces(False, False)
+            self.linear = tuple(space.project_matrix(m) for m in (operators.stiffness, operators.damping,
+                                                                   operators.mass))
+        self._kinetic = fem.form(energy(kinetic, energies.kinetic_energy_density(p, self.U, self.V, False)))
+        self._strain = fem.form(energy(strain, energies.strain_energy_density(p, energies.strain_slots(self.U),
+                                                                              False)))
         self.c_u, self.c_v, self.c_a = (fem.Constant(disc.mesh, PETSc.ScalarType(0.0)) for _ in range(3))
         jacobian = (
             self.c_u * ufl.derivative(residual, self.U, dU)
@@ -80,25 +125,33 @@ class AssembledInternalForce:
         )
         self._residual = fem.form(residual)
         self._jacobian = fem.form(jacobian)
-        kinetic = energies.kinetic_energy_density(p, self.U, self.V, inertial_nonlinearity, angular_velocity)
-        self._kinetic = fem.form(kinetic * dx)
-        strain = energies.strain_energy_density(p, energies.strain_slots(self.U), geometric_nonlinearity, kinematics)
-        self._strain = fem.form(strain * dx)
         self._vector = fem_petsc.create_vector(self._residual.function_spaces)
         self._matrix = fem_petsc.create_matrix(self._jacobian)
         self._damping = space.project_matrix(operators.damping)  # (45) is linear: reused for the budget
 
     def _set(self, function: fem.Function, values: np.ndarray) -> None:
-        function.x.array[:] = self.space.expand(values)
+        if self.dofs is None:
+            function.x.array[:] = self.space.expand(values)
+        else:  # only the dofs of the sampled cells enter their kernels
+            function.x.array[self.dofs] = self.phi_rows @ values
 
-    def evaluate(self, q, qd, qdd) -> np.ndarray:
+    def assembled_vector(self, q, qd, qdd) -> np.ndarray:
+        """The assembled (full-space) vector of the residual form at a state: the whole force, or the
+        sample's weighted nonlinear remainder."""
         self._set(self.U, q)
         self._set(self.V, qd)
         self._set(self.A, qdd)
         with self._vector.localForm() as local:
             local.set(0.0)
         fem_petsc.assemble_vector(self._vector, self._residual)
-        return self.space.project(self._vector.array)
+        return self._vector.array
+
+    def evaluate(self, q, qd, qdd) -> np.ndarray:
+        vector = self.assembled_vector(q, qd, qdd)
+        if self.dofs is None:
+            return self.space.project(vector)
+        K, C, M = self.linear
+        return K @ q + C @ qd + M @ qdd + self.phi_rows.T @ vector[self.dofs]
 
     state_dependent = True
 
@@ -107,7 +160,10 @@ class AssembledInternalForce:
         self._matrix.zeroEntries()
         fem_petsc.assemble_matrix(self._matrix, self._jacobian)
         self._matrix.assemble()
-        return self.space.project_matrix(petsc_to_scipy(self._matrix))
+        tangent = self.space.project_matrix(petsc_to_scipy(self._matrix))
+        if self.dofs is not None:
+            tangent = tangent + sum(c * m for c, m in zip((c_u, c_v, c_a), self.linear) if c != 0)
+        return tangent
 
     def tangent_parts(self, needed=(True, True, True)):
         """(df/dq, df/dqd, df/dqdd) at the state of the last :meth:`evaluate`; None for a part not
@@ -118,20 +174,24 @@ class AssembledInternalForce:
     def kinetic_energy(self, q, qd) -> float:
         self._set(self.U, q)
         self._set(self.V, qd)
-        return fem.assemble_scalar(self._kinetic)
+        value = fem.assemble_scalar(self._kinetic)
+        return value if self.dofs is None else value + 0.5 * float(qd @ (self.linear[2] @ qd))
 
     def strain_energy(self, q) -> float:
         self._set(self.U, q)
-        return fem.assemble_scalar(self._strain)
+        value = fem.assemble_scalar(self._strain)
+        return value if self.dofs is None else value + 0.5 * float(q @ (self.linear[0] @ q))
 
     def damping_force(self, qd) -> np.ndarray:
         return self._damping @ qd
 
 
-def internal_force(disc: BeamDiscretization, space, operators: LinearOperators, model):
-    """The internal force the scene's [model] switches ask for: nothing nonlinear is assembled when off."""
+def internal_force(disc: BeamDiscretization, space, operators: LinearOperators, model,
+                   sample: ElementSample | None = None):
+    """The internal force the scene's [model] switches ask for: nothing nonlinear is assembled when off;
+    with ``sample``, the nonlinear part on those elements only."""
     geometric, inertial = model.geometric_nonlinearity, model.inertial_nonlinearity
     if not (geometric or inertial):
         return LinearInternalForce(space, operators)
     return AssembledInternalForce(disc, space, operators, geometric, inertial, model.kinematics,
-                                  model.angular_velocity)
+                                  model.angular_velocity, sample)

@@ -18,6 +18,8 @@ import numpy as np
 
 from fenics_drill.model.drillstring import DrillstringModel, build_model
 from fenics_drill.model.enrichment import missed_share
+from fenics_drill.model.hyper_reduction import train_sample
+from fenics_drill.model.internal_force import AssembledInternalForce
 from fenics_drill.model.spaces import ModalSpace
 from fenics_drill.observables.drilling_quantities import bit_bounce, drilling_quantities, stick_slip
 from fenics_drill.observables.step_rows import StepRows
@@ -40,13 +42,15 @@ class PreparedScene:
     setup_time_s: float
 
 
-def prepare(scene) -> PreparedScene:
+def prepare(scene, dynamics: bool = True) -> PreparedScene:
     """Build the model and solve its static equilibrium (raises StaticFailure).
 
     A reduced model whose basis misses the string's state at rest beyond ``reduction.guard_tolerance``
     (a heavy string on the wall, a long one sagging far: large deflections that the modes and their
     companions carry only approximately) gets that state, solved once in the full order, as one more
-    basis vector when ``reduction.enrich`` is on; the guard's report says so (``static_state``)."""
+    basis vector when ``reduction.enrich`` is on; the guard's report says so (``static_state``).
+    With ``dynamics`` and ``reduction.hyper``, a modal model's nonlinear forces are then sampled
+    (:func:`_with_element_sample`)."""
     clock = time.perf_counter()
     model = build_model(scene)
     initial = None
@@ -57,7 +61,37 @@ def prepare(scene) -> PreparedScene:
     setup = time.perf_counter() - clock
     equilibrium = solve_static(model, initial=initial)
     static = {k: v for k, v in static_report(model, equilibrium).items() if k != "contact_vertices"}
+    if dynamics and scene.reduction.hyper and isinstance(model.space, ModalSpace) \
+            and isinstance(model.internal, AssembledInternalForce):
+        model = _with_element_sample(model, scene, equilibrium)
     return PreparedScene(model, equilibrium, static, setup)
+
+
+#: Training states kept from the training run (evenly spaced in its steps).
+TRAINING_STATES = 12
+
+
+def _with_element_sample(model: DrillstringModel, scene, equilibrium: StaticEquilibrium) -> DrillstringModel:
+    """The model with its nonlinear internal forces on an ECSW element sample, trained on the first
+    ``reduction.hyper_training`` seconds of the unsampled model from the static state; the model as it
+    was if that run fails (said in its ``hyper_reduction`` report)."""
+    clock = time.perf_counter()
+    horizon = min(scene.reduction.hyper_training, scene.time.t_end)
+    simulation = Simulation(model, scene)
+    states = []
+    try:
+        simulation.run(simulation.initial_state(equilibrium.q), horizon,
+                       lambda r: states.append((r.state.q, r.state.qd, r.state.qdd)))
+    except StepTooSmall as failure:
+        model.hyper_reduction = {"elements": None, "message": f"training run failed, all elements kept: {failure}"}
+        return model
+    chosen = np.unique(np.linspace(0, len(states) - 1, TRAINING_STATES).round().astype(int))
+    m = scene.model
+    switches = (m.geometric_nonlinearity, m.inertial_nonlinearity, m.kinematics, m.angular_velocity)
+    sample, report = train_sample(model.disc, model.space, model.operators, switches,
+                                  [states[i] for i in chosen], scene.reduction.hyper_tolerance)
+    report.update(training_time_s=time.perf_counter() - clock, training_horizon_s=horizon)
+    return model.with_sample(sample, report)
 
 
 def _with_static_state(model: DrillstringModel, tolerance: float) -> tuple[DrillstringModel, np.ndarray]:
