@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
+import scipy.sparse as sp
 
 from fenics_drill.model.discretization import THETA_X as TX_FIELD
 from fenics_drill.model.discretization import U as U_FIELD
@@ -22,7 +23,6 @@ from fenics_drill.model.discretization import V as V_FIELD
 from fenics_drill.model.discretization import W as W_FIELD
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
-from fenics_drill.model.spaces import weighted_product
 from fenics_drill.scene import LAW_SIGN
 
 FIELDS = (U_FIELD, V_FIELD, W_FIELD, TX_FIELD)  # the fields the wall acts on: F_a, F_v, F_w, T_FS
@@ -104,10 +104,15 @@ class WallContact:
         self.mu_axial = law_sign[0] * contact.friction
         self.mu_torque = law_sign[1] * contact.friction
         self.v_s = contact.sliding_velocity_scale
-        self.rows = {f: space.rows(disc.vertex_dofs(f)) for f in FIELDS}
-        # dense [Phi]: the four rows of each vertex side by side (n_vertices, 4, N_red), so the contact
-        # set's rows are one gather and the tangent one batched product (sparse spaces keep the dict)
-        self.stacked = None if space.sparse else np.stack([self.rows[f] for f in FIELDS], axis=1)
+        # the rows of [Phi] of (u, v, w, theta_x) at every vertex, interleaved: row 4 i + k is field k at
+        # vertex i, so one product gives all four fields at all vertices and projects all their forces
+        by_field = [space.rows(disc.vertex_dofs(f)) for f in FIELDS]
+        n = len(self.x)
+        order = (np.arange(len(FIELDS))[None, :] * n + np.arange(n)[:, None]).ravel()
+        if space.sparse:
+            self.flat = sp.vstack(by_field, format="csr")[order]
+        else:
+            self.flat = np.ascontiguousarray(np.vstack(by_field)[order])
 
     @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "WallContact":
@@ -124,28 +129,27 @@ class WallContact:
     def record(self, forces: "WallForces") -> dict[str, float]:
         return {"vertices_in_contact": int(forces.in_contact.sum())}
 
+    def vertex_values(self, q: np.ndarray) -> np.ndarray:
+        """(u, v, w, theta_x) at every vertex: (n_vertices, 4)."""
+        return (self.flat @ q).reshape(-1, len(FIELDS))
+
     def lateral(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """v and w at every vertex."""
-        return self.rows[V_FIELD] @ q, self.rows[W_FIELD] @ q
+        values = self.vertex_values(q)
+        return values[:, 1], values[:, 2]
 
     def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> WallForces:
-        v, w = self.lateral(q)
+        values = self.vertex_values(q)
+        v, w = values[:, 1], values[:, 2]
         delta = indentation(v, w, self.gap)
         active = np.flatnonzero(delta > 0)
-        r = self.rows
-        zero = np.zeros_like(q)
         if active.size == 0:
-            empty = np.zeros(0)
+            zero, empty = np.zeros_like(q), np.zeros(0)
             laws = dict.fromkeys(("wall_damper", "wall_axial_friction", "wall_friction_torque"), zero)
             return WallForces(zero, 0.0, laws, delta, delta > 0, empty, empty, empty, {} if with_tangent else None)
-        if self.stacked is None:
-            block, rows = None, {f: r[f][active] for f in r}
-        else:
-            block = self.stacked[active]
-            rows = {f: block[:, k] for k, f in enumerate(FIELDS)}
+        rates = self.vertex_values(qd)[active]
+        du, dv, dw, dtx = rates.T
         va, wa = v[active], w[active]
-        dv, dw = rows[V_FIELD] @ qd, rows[W_FIELD] @ qd
-        du, dtx = rows[U_FIELD] @ qd, rows[TX_FIELD] @ qd
         radius = np.hypot(va, wa)
         n_v, n_w = va / radius, wa / radius
         d = delta[active]
@@ -153,21 +157,25 @@ class WallContact:
         normal = hunt_crossley_normal_force(d, d_rate, self.k1, self.k2, self.c)
         axial, torque = wall_friction(normal, du, dtx, self.mu_axial, self.borehole_radius, self.v_s, self.mu_torque)
         elastic = -self.k1 * d - self.k2 * d**3
-        generalised = (
-            rows[U_FIELD].T @ axial + rows[V_FIELD].T @ (normal * n_v)
-            + rows[W_FIELD].T @ (normal * n_w) + rows[TX_FIELD].T @ torque
-        )
         damper = normal - elastic  # the Hunt-Crossley damper, with the clip that keeps the wall from pulling
-        laws = {"wall_damper": rows[V_FIELD].T @ (damper * n_v) + rows[W_FIELD].T @ (damper * n_w),
-                "wall_axial_friction": rows[U_FIELD].T @ axial, "wall_friction_torque": rows[TX_FIELD].T @ torque}
+        # nodal loads (F_a, F_v, F_w, T) of the total force and of each non-conservative law, projected at once
+        loads = np.zeros((len(delta), len(FIELDS), 4))
+        loads[active, 0, 0] = axial
+        loads[active, 1, 0], loads[active, 2, 0] = normal * n_v, normal * n_w
+        loads[active, 3, 0] = torque
+        loads[active, 1, 1], loads[active, 2, 1] = damper * n_v, damper * n_w
+        loads[active, 0, 2] = axial
+        loads[active, 3, 3] = torque
+        projected = np.asarray(self.flat.T @ loads.reshape(-1, 4))
+        laws = {"wall_damper": projected[:, 1], "wall_axial_friction": projected[:, 2],
+                "wall_friction_torque": projected[:, 3]}
         potential = float(np.sum(0.5 * self.k1 * d**2 + 0.25 * self.k2 * d**4))
-        out = WallForces(generalised, potential, laws, delta, delta > 0, normal, axial, torque)
+        out = WallForces(projected[:, 0], potential, laws, delta, delta > 0, normal, axial, torque)
         if with_tangent:
-            out.derivatives = self._derivatives(rows, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal)
-            out.derivatives["block"] = block
+            out.derivatives = self._derivatives(active, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal)
         return out
 
-    def _derivatives(self, rows, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal) -> dict:
+    def _derivatives(self, active, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal) -> dict:
         """Pointwise derivatives of (F_a, F_v, F_w, T) w.r.t. vertex displacements and velocities."""
         pushing = normal < 0  # where the clip of (17) is active the force and its derivatives vanish
         spring = np.where(pushing, -self.k1 - 3 * self.k2 * d**2 - 3 * self.c * d**2 * d_rate, 0.0)
@@ -194,27 +202,25 @@ class WallContact:
             (U, U): mu_a * normal * (1 - s_a**2) / self.v_s,
             (TX, TX): mu_t * R * normal * (1 - s_t**2) * R / self.v_s,
         }
-        return {"rows": rows, "position": position, "velocity": velocity}
+        return {"active": active, "position": position, "velocity": velocity}
 
-    @staticmethod
-    def tangent(forces: WallForces, c_u: float, c_v: float):
+    def tangent(self, forces: WallForces, c_u: float, c_v: float):
         """c_u d f/dq + c_v d f/dqd of the generalised wall force (None without contact):
-        sum over (out, in) of rows_out^T diag(c_u w_pos + c_v w_vel) rows_in."""
+        sum over the vertices in contact of R_i^T A_i R_i, with R_i the four rows of [Phi] of
+        vertex i and A_i the 4 x 4 block of the pointwise derivatives."""
         if not forces.derivatives:
             return None
-        rows, block = forces.derivatives["rows"], forces.derivatives["block"]
-        position, velocity = forces.derivatives["position"], forces.derivatives["velocity"]
-        if block is None:  # sparse rows (the full order)
-            weights: dict = {}
-            for scale, derivatives in ((c_u, position), (c_v, velocity)):
-                for pair, w in derivatives.items():
-                    weights[pair] = weights.get(pair, 0.0) + scale * w
-            return sum(weighted_product(rows[out], w, rows[inp]) for (out, inp), w in weights.items())
-        # dense [Phi]: per vertex a 4 x 4 block of derivatives; sum_i R_i^T A_i R_i as one product
-        n, size = block.shape[0], block.shape[2]
+        active = forces.derivatives["active"]
         index = {f: k for k, f in enumerate(FIELDS)}
-        weights = np.zeros((n, 4, 4))
-        for scale, derivatives in ((c_u, position), (c_v, velocity)):
+        weights = np.zeros((active.size, len(FIELDS), len(FIELDS)))
+        for scale, derivatives in ((c_u, forces.derivatives["position"]), (c_v, forces.derivatives["velocity"])):
             for (out, inp), w in derivatives.items():
                 weights[:, index[out], index[inp]] += scale * w
-        return block.reshape(n * 4, size).T @ np.matmul(weights, block).reshape(n * 4, size)
+        rows = (len(FIELDS) * active[:, None] + np.arange(len(FIELDS))).ravel()
+        block = self.flat[rows]
+        if sp.issparse(block):
+            diagonal = sp.bsr_matrix((weights, np.arange(active.size), np.arange(active.size + 1)),
+                                     shape=(rows.size, rows.size))
+            return sp.csr_matrix(block.T @ (diagonal @ block))
+        size = block.shape[1]
+        return block.T @ np.matmul(weights, block.reshape(active.size, len(FIELDS), size)).reshape(rows.size, size)
