@@ -34,7 +34,11 @@ demo-as-printed: setup
 test: setup
 	$(PY) -m pytest -q tests
 
+## Speed before and after issue 17 (benchmarks/speed.md, about 25 min), the reduced models against the
+## full order (benchmarks/reduced_accuracy.md, issue 14), then the older studies.
 bench: setup
+	$(PY) benchmarks/speed_table.py --before 50d35ac
+	$(PY) benchmarks/reduced_accuracy.py --t-end 2 --runs $(OUT)/accuracy
 	$(PY) benchmarks/modal_timing.py
 	$(PY) benchmarks/dynamics_convergence.py
 	$(PY) benchmarks/tradeoff.py demos/scenes/paper.toml --t-end 0.5

@@ -26,6 +26,7 @@ import numpy as np
 
 from fenics_drill.model.discretization import THETA_X, U, V, W, BeamDiscretization
 from fenics_drill.model.forces import ForceEvaluation, build_forces
+from fenics_drill.model.hyper_reduction import RETRAIN_ABOVE, sampling_error, train_sample
 from fenics_drill.model.internal_force import ElementSample, internal_force
 from fenics_drill.model.operators import LinearOperators, assemble_linear
 from fenics_drill.model.enrichment import augment
@@ -74,7 +75,7 @@ class DrillstringModel:
         # bit, the axial displacement and the arc r theta_x of the surface (the bit-rock law's stiff laws)
         self.error_rows = (*self.lateral_rows, self.bit_rows[0:1], disc.properties.outer_radius * self.bit_rows[1:2])
         self.operators = operators
-        self.exact_internal, self.hyper_reduction = None, None  # set by with_sample
+        self.exact_internal, self.hyper_reduction, self.training_states = None, None, []  # set by with_sample
 
     @property
     def size(self) -> int:
@@ -159,15 +160,36 @@ class DrillstringModel:
         return DrillstringModel(self.scene, self.disc, ModalSpace(phi), self.operators, self.basis, self.modes,
                                 guard)
 
-    def with_sample(self, sample: ElementSample, report: dict) -> "DrillstringModel":
+    def with_sample(self, sample: ElementSample, report: dict, training_states: list) -> "DrillstringModel":
         """A model whose nonlinear internal forces are evaluated on an element sample (ECSW,
         :mod:`fenics_drill.model.hyper_reduction`); the unsampled forces stay as ``exact_internal``, the
-        reference of the error indicator, and ``report`` says how the sample was trained."""
+        reference of the error indicator, and ``report`` says how the sample was trained on
+        ``training_states``."""
         model = copy.copy(self)
         model.exact_internal = self.internal
         model.internal = internal_force(self.disc, self.space, self.operators, self.scene.model, sample)
-        model.hyper_reduction = dict(report)
+        model.hyper_reduction = {**report, "retrainings": 0}
+        model.training_states = list(training_states)
         return model
+
+    def check_sample(self, q, qd, qdd) -> tuple[float, bool] | None:
+        """The error indicator of a sampled model at a state (None without a sample), and whether the
+        sample was retrained there: beyond RETRAIN_ABOVE this model's sample is trained again with the
+        state among its training states (the shared model that this one was copied from keeps its own)."""
+        if self.exact_internal is None:
+            return None
+        error = sampling_error(self.exact_internal, self.internal, q, qd, qdd)
+        if error <= RETRAIN_ABOVE:
+            return error, False
+        m = self.scene.model
+        switches = (m.geometric_nonlinearity, m.inertial_nonlinearity, m.kinematics, m.angular_velocity)
+        self.training_states = [*self.training_states, (q.copy(), qd.copy(), qdd.copy())]
+        sample, report = train_sample(self.disc, self.space, self.operators, switches, self.training_states,
+                                      self.scene.reduction.hyper_tolerance)
+        self.internal = internal_force(self.disc, self.space, self.operators, m, sample)
+        retrainings = self.hyper_reduction["retrainings"] + 1
+        self.hyper_reduction = {**self.hyper_reduction, **report, "retrainings": retrainings}
+        return error, True
 
     def drive_velocity_field(self) -> np.ndarray:
         """Initial velocity of Section 3.2 in reduced coordinates: u_dot = V0, theta_x_dot = Omega,

@@ -15,7 +15,9 @@ the weighted element energies, so the sampled model conserves energy as the full
 
 The training states are the states of a short run of the unsampled reduced model, each also
 turned through a revolution of the spin (theta_x shifted by 2 pi k / n_spin): a drilling string
-turns, and the nonlinear forces depend on the spin angle through its sine and cosine.
+turns, and the nonlinear forces depend on the spin angle through its sine and cosine.  During a
+run the sample is checked against all elements every CHECK_INTERVAL (the error indicator); a state
+it misses by more than RETRAIN_ABOVE joins the training states and the sample is trained again.
 """
 
 from __future__ import annotations
@@ -27,6 +29,11 @@ from fenics_drill.model.internal_force import AssembledInternalForce, ElementSam
 
 #: Spin angles per training state: the forces are trigonometric polynomials of low degree in theta_x.
 SPIN_SHIFTS = 6
+#: Simulated time between two checks of a sample against all elements during a run [s].
+CHECK_INTERVAL = 0.1
+#: A check finding the sampled nonlinear force further than this from all elements' retrains the sample
+#: with that state added [-].
+RETRAIN_ABOVE = 0.01
 
 
 def sparse_nnls(G: np.ndarray, b: np.ndarray, tolerance: float, max_columns: int | None = None) -> np.ndarray:

@@ -17,6 +17,11 @@ from fenics_drill.model.drillstring import DrillstringModel, Evaluation
 from fenics_drill.solvers.newton import saddle_newton
 
 
+#: A Newton iterate keeps the tangent of the previous one while the residual shrinks at least this much
+#: per update (the stiff bit and wall laws make it rarely so in their transients: then it is fresh).
+TANGENT_REUSE_RATE = 0.1
+
+
 class NewtonFailure(RuntimeError):
     """Newton did not converge within the allowed iterations (or produced non-finite values)."""
 
@@ -52,6 +57,10 @@ class NewmarkNewton:
         self._internal_parts = None
         self._steps_since_tangent = 0
         self._force_level = 0.0
+
+    def forget_tangent(self) -> None:
+        """Assemble the internal tangent afresh at the next step (the internal force has changed)."""
+        self._internal_parts = None
 
     def constraint_target(self, t: float, h0: np.ndarray) -> np.ndarray:
         """h(t) of (71) for the rows the basis leaves: u(0, t) = V0 t, theta_x(0, t) = Omega t."""
@@ -120,7 +129,7 @@ class NewmarkNewton:
         stale = self._internal_parts is None or self._steps_since_tangent >= self.tangent_reuse
         ev = evaluate(q, mu, stale and self.model.internal.state_dependent)
         result = saddle_newton(lambda q, mu: evaluate(q, mu), self.model.space, self.model.constraints, target,
-                               q, mu, ev, check, self.max_iterations)
+                               q, mu, ev, check, self.max_iterations, reuse_rate=TANGENT_REUSE_RATE)
         if result is None:
             raise NewtonFailure(f"Newton did not converge in {self.max_iterations} iterations at dt = {dt:.3e} s")
         return result

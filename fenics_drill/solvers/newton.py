@@ -33,26 +33,35 @@ def backtrack(trial, norm0: float, step: float = 1.0):
 
 def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np.ndarray, q: np.ndarray,
                   mu: np.ndarray, evaluation, check: Callable, max_iterations: int,
-                  first_step: Callable[[np.ndarray], float] | None = None):
+                  first_step: Callable[[np.ndarray], float] | None = None, reuse_rate: float = 0.0):
     """Iterate from (q, mu), whose ``evaluation`` (with ``.residual`` and ``.tangent``) is given.
 
     ``evaluate(q, mu)`` evaluates a trial state.  Before each update
     ``check(iteration, q, mu, evaluation, norm, gap)`` returns the result to stop with,
     or None to go on (it may raise).  ``first_step(dq)`` caps the first trial step of the
-    line search (default 1).  Returns None when ``max_iterations`` updates did not satisfy ``check``.
+    line search (default 1).  With ``reuse_rate`` > 0 the tangent of an earlier iterate is kept
+    while each full update shrinks the residual norm at least by that factor (a modified Newton with a
+    convergence-rate test; Deuflhard 2004, Sec. 2.1); a slower or damped update takes a fresh one.
+    Returns None when ``max_iterations`` updates did not satisfy ``check``.
     """
     norm = np.linalg.norm(evaluation.residual)
+    tangent = None
     for iteration in range(1, max_iterations + 1):
         gap = constraints @ q - target
         verdict = check(iteration, q, mu, evaluation, norm, gap)
         if verdict is not None:
             return verdict
-        dq, dmu = space.saddle_solve(evaluation.tangent, constraints, -evaluation.residual, -gap)
+        if tangent is None:
+            tangent = evaluation.tangent
+        dq, dmu = space.saddle_solve(tangent, constraints, -evaluation.residual, -gap)
 
         def trial(step):
             result = evaluate(q + step * dq, mu + step * dmu)
             return np.linalg.norm(result.residual), result
 
+        previous = norm
         step, norm, evaluation = backtrack(trial, norm, 1.0 if first_step is None else first_step(dq))
         q, mu = q + step * dq, mu + step * dmu
+        if step < 1.0 or norm > reuse_rate * previous:
+            tangent = None
     return None

@@ -1,5 +1,6 @@
 """The time loop of a drilling run: static start (Section 6.4), initial conditions (Section 3.2),
-adaptive Newmark/Newton steps, impact counting and the energy budget.
+adaptive Newmark/Newton steps, impact counting, the energy budget and the check of a hyper-reduced
+model's element sample.
 
 It knows nothing about files: every accepted step is handed to ``on_step`` as a
 :class:`StepRecord`, and the I/O layer decides what to keep.
@@ -13,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fenics_drill.model.drillstring import DrillstringModel, Evaluation
+from fenics_drill.model.hyper_reduction import CHECK_INTERVAL
 from fenics_drill.solvers.energy_budget import EnergyBudget, PowerTerms
 from fenics_drill.solvers.newmark import NewmarkNewton, NewtonFailure, State
 from fenics_drill.solvers.step_control import StepController
@@ -45,7 +47,9 @@ class Simulation:
         n_vertices = len(model.disc.vertex_x)
         self.impacts_per_vertex = np.zeros(n_vertices, dtype=np.int64)
         self.stats = {"steps": 0, "rejected_steps": 0, "newton_failures": 0, "newton_iterations": 0,
-                      "min_dt": np.inf, "max_dt": 0.0, "forced_steps": 0, "max_penetration": 0.0}
+                      "min_dt": np.inf, "max_dt": 0.0, "forced_steps": 0, "max_penetration": 0.0,
+                      "sampling_checks": 0, "max_sampling_error": 0.0, "sample_retrainings": 0}
+        self._next_sampling_check = 0.0
         self.last_state: State | None = None  # the latest accepted state (what an interrupted run keeps)
 
     def initial_state(self, q0: np.ndarray) -> State:
@@ -81,6 +85,19 @@ class Simulation:
         """Vertices in contact with the wall at an evaluated state (``previous`` when contact is off)."""
         wall = ev.forces.get("wall")
         return wall.in_contact if wall is not None else previous
+
+    def _check_sample(self, state: State) -> None:
+        """Every CHECK_INTERVAL: the element sample against all elements; retrained where it misses
+        (the internal tangent kept by the stepper is then stale and is assembled afresh)."""
+        if self.model.exact_internal is None or state.t < self._next_sampling_check - 1e-12:
+            return
+        error, retrained = self.model.check_sample(state.q, state.qd, state.qdd)
+        self.stats["sampling_checks"] += 1
+        self.stats["max_sampling_error"] = max(self.stats["max_sampling_error"], error)
+        if retrained:
+            self.stats["sample_retrainings"] += 1
+            self.stepper.forget_tangent()
+        self._next_sampling_check = CHECK_INTERVAL * (np.floor(state.t / CHECK_INTERVAL + 1e-9) + 1)
 
     def run(self, state: State, t_end: float, on_step=None, progress=None) -> State:
         """Step from ``state`` to t_end; raises StepTooSmall (with when and why) if the step collapses.
@@ -126,6 +143,7 @@ class Simulation:
             self.stats["max_penetration"] = max(self.stats["max_penetration"], self._penetration(new_ev))
             state, ev, powers, in_contact = new, new_ev, new_powers, new_contact
             self.last_state = state
+            self._check_sample(state)
             if on_step is not None:
                 on_step(StepRecord(state, dt, iterations, ev, onsets, in_contact, budget, self.stats["steps"]))
             if progress is not None:

@@ -88,10 +88,11 @@ def _with_element_sample(model: DrillstringModel, scene, equilibrium: StaticEqui
     chosen = np.unique(np.linspace(0, len(states) - 1, TRAINING_STATES).round().astype(int))
     m = scene.model
     switches = (m.geometric_nonlinearity, m.inertial_nonlinearity, m.kinematics, m.angular_velocity)
-    sample, report = train_sample(model.disc, model.space, model.operators, switches,
-                                  [states[i] for i in chosen], scene.reduction.hyper_tolerance)
+    training = [states[i] for i in chosen]
+    sample, report = train_sample(model.disc, model.space, model.operators, switches, training,
+                                  scene.reduction.hyper_tolerance)
     report.update(training_time_s=time.perf_counter() - clock, training_horizon_s=horizon)
-    return model.with_sample(sample, report)
+    return model.with_sample(sample, report, training)
 
 
 def _with_static_state(model: DrillstringModel, tolerance: float) -> tuple[DrillstringModel, np.ndarray]:

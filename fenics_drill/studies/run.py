@@ -22,7 +22,6 @@ from fenics_drill.io.output_directory import claim_output
 from fenics_drill.io.timeseries import TimeSeriesWriter, read_series
 from fenics_drill.model.discretization import DRIVE
 from fenics_drill.model.drillstring import DrillstringModel, build_model
-from fenics_drill.model.hyper_reduction import sampling_error
 from fenics_drill.model.modes import solve_modes
 from fenics_drill.model.resources import check_memory
 from fenics_drill.observables.drilling_quantities import drilling_quantities
@@ -38,10 +37,6 @@ from fenics_drill.studies.prepare import prepare
 #: Hunt-Crossley law (17) models a stiff wall, so a deep penetration means the time step or the contact
 #: stiffness does not resolve the impacts.
 PENETRATION_LIMIT = 0.1
-#: Simulated time between two checks of an element sample against all elements [s].
-SAMPLING_CHECK_INTERVAL = 0.1
-#: A sampled nonlinear internal force further than this from all elements' makes a run "suspect" [-].
-SAMPLING_ERROR_LIMIT = 0.01
 
 
 def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
@@ -101,23 +96,6 @@ class RunRecorder:
             if self.field_interval > 0 else None
         self.next_field_time = 0.0
         self.last_state = None  # the latest state whose row is in the series (what an interrupted run reports)
-        self.sampling_errors: list[tuple[float, float]] = []  # (t, indicator) of a hyper-reduced model
-        self.next_check_time = 0.0
-
-    def _check_sampling(self, state) -> None:
-        """Every SAMPLING_CHECK_INTERVAL: the sampled internal force against all elements at this state."""
-        if self.model.exact_internal is not None and state.t >= self.next_check_time - 1e-12:
-            error = sampling_error(self.model.exact_internal, self.model.internal, state.q, state.qd, state.qdd)
-            self.sampling_errors.append((state.t, error))
-            self.next_check_time = SAMPLING_CHECK_INTERVAL * (np.floor(state.t / SAMPLING_CHECK_INTERVAL + 1e-9) + 1)
-
-    def hyper_reduction_report(self) -> dict | None:
-        """The sample's training report with the largest indicator the run met (None without a sample)."""
-        if self.model.hyper_reduction is None:
-            return None
-        worst = max(self.sampling_errors, key=lambda te: te[1], default=(None, None))
-        return {**self.model.hyper_reduction, "indicator_checks": len(self.sampling_errors),
-                "max_indicator": worst[1], "max_indicator_t": worst[0]}
 
     def _write_fields(self, t: float, dofs: np.ndarray) -> None:
         if self.fields is not None and t >= self.next_field_time - 1e-12:
@@ -128,7 +106,6 @@ class RunRecorder:
     def __call__(self, record: StepRecord) -> None:
         dofs = self.model.space.expand(record.state.q)
         self._write_fields(record.state.t, dofs)
-        self._check_sampling(record.state)
         written = self.series.append(self.rows(record, dofs))
         self.last_state = record.state
         if written:
@@ -195,8 +172,11 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
             if recorder is not None:
                 recorder.close(simulation.impacts_per_vertex)
                 summary.update(quantities_of_run(out / "timeseries.h5"))
-                if recorder.hyper_reduction_report() is not None:
-                    summary["hyper_reduction"] = recorder.hyper_reduction_report()
+            if simulation is not None and simulation.model.hyper_reduction is not None:
+                stats = simulation.stats
+                summary["hyper_reduction"] = {**simulation.model.hyper_reduction,
+                                              "checks": stats["sampling_checks"],
+                                              "max_error_found": stats["max_sampling_error"]}
             if simulation is not None:
                 _judge_admissibility(summary, simulation, scene)
             summary["wall_time_s"] = time.perf_counter() - clock
@@ -216,11 +196,6 @@ def _judge_admissibility(summary: dict, simulation: Simulation, scene) -> None:
         reasons.append(f"the string went {stats['max_penetration'] * 1e3:.3g} mm into the wall, more than "
                        f"{PENETRATION_LIMIT:.0%} of the {gap * 1e3:.3g} mm gap: the contact stiffness or the "
                        "time step does not resolve the impacts")
-    indicator = summary.get("hyper_reduction", {}).get("max_indicator")
-    if indicator is not None and indicator > SAMPLING_ERROR_LIMIT:
-        reasons.append(f"the element sample's internal force was {indicator:.2g} off the nonlinear force of all "
-                       f"elements (limit {SAMPLING_ERROR_LIMIT:g}): lower reduction.hyper_tolerance, lengthen "
-                       "reduction.hyper_training, or set reduction.hyper = false")
     if stats["forced_steps"]:
         reasons.append(f"{stats['forced_steps']} steps were accepted at the minimum step size with a local "
                        f"error up to {simulation.controller.worst_forced_ratio:.3g} times time.error_tolerance: "

@@ -1,0 +1,121 @@
+"""What runs cost before and after the speed work of issue 17, measured side by side in one sitting.
+
+    python benchmarks/speed_table.py [--before 50d35ac] [--runs out/speed] [--table benchmarks/speed.md]
+
+The revision ``--before`` is checked out with ``git worktree`` into RUNS/before-tree and run with the same
+interpreter as the working tree (its packages come first on sys.path), one run at a time on one core.
+Rows: the nominal 10 s scene, 2 s with the printed kinematics (wall impacts in the reduced models), a
+Monte Carlo batch (4 realisations of 2 s) and the full-order reference (1000 elements, dt/4, 0.2 s).
+Each gives wall time, steps, Newton iterations, the three costliest functions (cProfile, own time) and
+rop and efficiency against the full order (500 elements, nominal step, same horizon; run once and kept in
+RUNS/reference-*).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+SCENE = "demos/scenes/paper.toml"
+NOMINAL_DT = 0.0024659004490511254  # 1 / (2 f_max), f_max = 4 c_L / L of the paper scene (Section 6.2)
+ROWS = {
+    "nominal scene, 10 s": ("run", ["time.t_end=10.0"], "nominal-10s"),
+    "printed kinematics, 2 s": ("run", ["time.t_end=2.0", "model.kinematics='printed'"], "printed-2s"),
+    "Monte Carlo batch, 4 realisations of 2 s": ("mc", ["time.t_end=2.0"], None),
+    "full-order reference (1000 elements, dt/4), 0.2 s": (
+        "run", ["time.t_end=0.2", "reduction.rule='none'", "beam.elements=1000", f"time.dt={NOMINAL_DT / 4}"], None),
+}
+REFERENCES = {"nominal-10s": ["time.t_end=10.0"], "printed-2s": ["time.t_end=2.0", "model.kinematics='printed'"]}
+
+WORKER = r"""
+import cProfile, json, pstats, sys, time
+import dolfinx_solver  # noqa: F401
+from fenics_drill.scene import load_scene
+kind, scene_path, overrides, out = sys.argv[1], sys.argv[2], json.loads(sys.argv[3]), sys.argv[4]
+scene = load_scene(scene_path, overrides + ["output.field_interval=0"])
+profile = cProfile.Profile()
+clock = time.perf_counter()
+profile.enable()
+if kind == "run":
+    from fenics_drill.studies.run import run_scene
+    s = run_scene(scene, out, progress=False, overwrite=True)
+    result = {k: s.get(k) for k in ("status", "steps", "newton_iterations", "rop", "efficiency", "impacts_total")}
+else:
+    from fenics_drill.api import monte_carlo
+    s = monte_carlo(scene, 4, out)
+    result = {"status": "finished", "steps": None, "newton_iterations": None, "rop": None, "efficiency": None,
+              "impacts_total": None}
+profile.disable()
+result["wall_time_s"] = time.perf_counter() - clock
+stats = pstats.Stats(profile)
+top = sorted(stats.stats.items(), key=lambda kv: kv[1][2], reverse=True)[:3]
+result["profile"] = [f"{func[2]} ({func[0].split('/')[-1]}:{func[1]}) {row[2]:.1f} s" for func, row in top]
+print(json.dumps(result))
+"""
+
+
+def measure(tree: Path, kind: str, overrides: list[str], out: Path) -> dict:
+    """One row in one tree, in its own process on one core."""
+    env = {**os.environ, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "PYTHONPATH": str(tree)}
+    done = subprocess.run([sys.executable, "-c", WORKER, kind, str(tree / SCENE), json.dumps(overrides), str(out)],
+                          cwd=tree, env=env, capture_output=True, text=True)
+    lines = [line for line in done.stdout.splitlines() if line.startswith("{")]
+    if not lines:
+        return {"status": f"failed: {done.stderr.strip().splitlines()[-1] if done.stderr.strip() else '?'}"}
+    return json.loads(lines[-1])
+
+
+def reference(name: str, runs: Path) -> dict:
+    """The full order (500 elements, nominal step) of a row, run once with the working tree."""
+    out = runs / f"reference-{name}"
+    summary = out / "summary.json"
+    if not (summary.exists() and json.loads(summary.read_text()).get("status") in ("finished", "suspect")):
+        subprocess.run([sys.executable, "-m", "fenics_drill.cli", "run", SCENE, *[a for o in REFERENCES[name]
+                        for a in ("--set", o)], "--set", "reduction.rule='none'", "--set", "output.field_interval=0",
+                        "--quiet", "--overwrite", "--out", str(out)], cwd=ROOT, check=False,
+                       env={**os.environ, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"})
+    return json.loads(summary.read_text())
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--before", default="50d35ac")
+    parser.add_argument("--runs", type=Path, default=ROOT / "out/speed")
+    parser.add_argument("--table", type=Path, default=ROOT / "benchmarks/speed.md")
+    args = parser.parse_args()
+    runs = args.runs.resolve()
+    runs.mkdir(parents=True, exist_ok=True)
+    before_tree = runs / "before-tree"
+    if not before_tree.exists():
+        subprocess.run(["git", "worktree", "add", "--detach", str(before_tree), args.before], cwd=ROOT, check=True)
+    trees = {f"before ({args.before})": before_tree, "after": ROOT}
+    lines = [f"# Speed before and after issue 17 ({platform.processor() or platform.machine()}, "
+             f"{os.cpu_count()} cores, one per run)", "",
+             f"Command: `python benchmarks/speed_table.py --before {args.before}`. Accuracy: relative difference "
+             "of rop / efficiency from the full order (500 elements, nominal step, same horizon).", "",
+             "| row | code | wall [s] | steps | Newton iterations | rop / efficiency vs full order | "
+             "costliest functions (own time) |", "|---|---|---|---|---|---|---|"]
+    for row, (kind, overrides, ref_name) in ROWS.items():
+        ref = reference(ref_name, runs) if ref_name else None
+        for code, tree in trees.items():
+            r = measure(tree, kind, overrides, runs / f"{code.split()[0]}-{len(lines)}")
+            accuracy = "—"
+            if ref is not None and r.get("rop") is not None:
+                accuracy = (f"{abs(r['rop'] / ref['rop'] - 1):.1%} / "
+                            f"{abs(r['efficiency'] / ref['efficiency'] - 1):.1%}")
+            wall = r.get("wall_time_s")
+            lines.append(f"| {row} | {code} | {'' if wall is None else f'{wall:.1f}'} | {r.get('steps') or '—'} | "
+                         f"{r.get('newton_iterations') or '—'} | {accuracy} | "
+                         f"{'; '.join(r.get('profile', [r.get('status', '')]))} |")
+            print(lines[-1], flush=True)
+    args.table.write_text("\n".join(lines) + "\n")
+
+
+if __name__ == "__main__":
+    main()
