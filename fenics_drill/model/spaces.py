@@ -25,6 +25,20 @@ from fenics_drill.model.modes import ModalBasis, reduction_bands, select_modes, 
 from fenics_drill.model.operators import LinearOperators
 
 
+class SaddleFactorisation:
+    """The factorised saddle matrix of (76) of the last (tangent, constraints) pair: a Newton iterate
+    that keeps its tangent (modified Newton) solves without factorising again."""
+
+    def __init__(self, factorise):
+        self.factorise = factorise  # (tangent, constraints) -> (solve(rhs), scale k)
+        self.key = self.value = None
+
+    def __call__(self, tangent, constraints):
+        if self.key is None or self.key[0] is not tangent or self.key[1] is not constraints:
+            self.key, self.value = (tangent, constraints), self.factorise(tangent, constraints)
+        return self.value
+
+
 def constraint_scale(tangent, constraints) -> float:
     """Factor k for the rows of [B] in the saddle system (76): with k [B] the constraint rows
     have the size of the tangent's, otherwise the system is singular to working precision."""
@@ -39,6 +53,7 @@ class ModalSpace:
 
     def __init__(self, phi: np.ndarray):
         self.phi = np.ascontiguousarray(phi)
+        self._saddle = SaddleFactorisation(self._factorise)
 
     @property
     def size(self) -> int:
@@ -68,12 +83,18 @@ class ModalSpace:
     def solve(self, matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
         return sla.solve(matrix, rhs, check_finite=False)
 
-    def saddle_solve(self, tangent: np.ndarray, constraints: np.ndarray, rhs_q: np.ndarray, rhs_c: np.ndarray):
-        """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76)."""
+    @staticmethod
+    def _factorise(tangent: np.ndarray, constraints: np.ndarray):
         m = constraints.shape[0]
         k = constraint_scale(tangent, constraints)
         system = np.block([[tangent, k * constraints.T], [k * constraints, np.zeros((m, m))]])
-        x = sla.solve(system, np.concatenate([rhs_q, k * rhs_c]), check_finite=False)
+        factors = sla.lu_factor(system, check_finite=False)
+        return (lambda rhs: sla.lu_solve(factors, rhs, check_finite=False)), k
+
+    def saddle_solve(self, tangent: np.ndarray, constraints: np.ndarray, rhs_q: np.ndarray, rhs_c: np.ndarray):
+        """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76) (LU kept for the same J and B)."""
+        solve, k = self._saddle(tangent, constraints)
+        x = solve(np.concatenate([rhs_q, k * rhs_c]))
         return x[: self.size], k * x[self.size :]
 
 
@@ -85,6 +106,7 @@ class FullSpace:
     def __init__(self, ndofs: int, support_dofs: np.ndarray):
         self.free = np.setdiff1d(np.arange(ndofs), support_dofs)
         self.ndofs = ndofs
+        self._saddle = SaddleFactorisation(self._factorise)
         self.phi = sp.csr_matrix(
             (np.ones(self.free.size), (self.free, np.arange(self.free.size))), shape=(ndofs, self.free.size)
         )
@@ -113,12 +135,17 @@ class FullSpace:
     def solve(self, matrix, rhs: np.ndarray) -> np.ndarray:
         return spla.spsolve(sp.csc_matrix(matrix), rhs)
 
-    def saddle_solve(self, tangent, constraints, rhs_q: np.ndarray, rhs_c: np.ndarray):
-        """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76), with a sparse LU."""
+    @staticmethod
+    def _factorise(tangent, constraints):
         k = constraint_scale(tangent, constraints)
         B = sp.csr_matrix(k * np.asarray(constraints))
-        system = sp.bmat([[tangent, B.T], [B, None]], format="csc")
-        x = spla.splu(system).solve(np.concatenate([rhs_q, k * rhs_c]))
+        return spla.splu(sp.bmat([[tangent, B.T], [B, None]], format="csc")).solve, k
+
+    def saddle_solve(self, tangent, constraints, rhs_q: np.ndarray, rhs_c: np.ndarray):
+        """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76), with a sparse LU (kept for the
+        same J and B)."""
+        solve, k = self._saddle(tangent, constraints)
+        x = solve(np.concatenate([rhs_q, k * rhs_c]))
         return x[: self.size], k * x[self.size :]
 
 
