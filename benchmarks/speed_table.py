@@ -48,7 +48,7 @@ if kind == "run":
     result = {k: s.get(k) for k in ("status", "steps", "newton_iterations", "rop", "efficiency", "impacts_total")}
 else:
     from fenics_drill.api import monte_carlo
-    s = monte_carlo(scene, 4, out)
+    s = monte_carlo(scene, 4, out, overwrite=True)
     result = {"status": "finished", "steps": None, "newton_iterations": None, "rop": None, "efficiency": None,
               "impacts_total": None}
 profile.disable()

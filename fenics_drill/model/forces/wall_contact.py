@@ -171,8 +171,8 @@ class WallContact:
                 "wall_friction_torque": projected[:, 3]}
         potential = float(np.sum(0.5 * self.k1 * d**2 + 0.25 * self.k2 * d**4))
         out = WallForces(projected[:, 0], potential, laws, delta, delta > 0, normal, axial, torque)
-        if with_tangent:
-            out.derivatives = self._derivatives(active, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal)
+        if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
+            out.derivatives = {"at": (active, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal)}
         return out
 
     def _derivatives(self, active, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal) -> dict:
@@ -210,10 +210,11 @@ class WallContact:
         vertex i and A_i the 4 x 4 block of the pointwise derivatives."""
         if not forces.derivatives:
             return None
-        active = forces.derivatives["active"]
+        pointwise = self._derivatives(*forces.derivatives["at"])
+        active = pointwise["active"]
         index = {f: k for k, f in enumerate(FIELDS)}
         weights = np.zeros((active.size, len(FIELDS), len(FIELDS)))
-        for scale, derivatives in ((c_u, forces.derivatives["position"]), (c_v, forces.derivatives["velocity"])):
+        for scale, derivatives in ((c_u, pointwise["position"]), (c_v, pointwise["velocity"])):
             for (out, inp), w in derivatives.items():
                 weights[:, index[out], index[inp]] += scale * w
         rows = (len(FIELDS) * active[:, None] + np.arange(len(FIELDS))).ravel()
