@@ -21,7 +21,7 @@ import scipy.sparse.linalg as spla
 
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.enrichment import augment, enrich
-from fenics_drill.model.modes import ModalBasis, reduction_bands, select_modes, solve_modes, stuck_bit_modes
+from fenics_drill.model.modes import reduction_bands, select_modes, solve_modes, stuck_bit_modes
 from fenics_drill.model.operators import LinearOperators
 
 

@@ -21,12 +21,12 @@ from fenics_drill.io.files import write_json
 from fenics_drill.io.output_directory import claim_output
 from fenics_drill.io.timeseries import TimeSeriesWriter, read_series
 from fenics_drill.model.discretization import DRIVE
-from fenics_drill.model.drillstring import DrillstringModel, build_model
+from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.model.modes import solve_modes
 from fenics_drill.model.resources import check_memory
 from fenics_drill.observables.drilling_quantities import drilling_quantities
 from fenics_drill.observables.step_rows import StepRows
-from fenics_drill.solvers.static import StaticFailure, solve_static, static_report
+from fenics_drill.solvers.static import StaticFailure, static_report
 from fenics_drill.solvers.step_control import StepTooSmall, nominal_step
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
 from fenics_drill.studies.lifecycle import StopOnSignal, command_output
