@@ -17,10 +17,12 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
 from petsc4py import PETSc
 from slepc4py import SLEPc
 
-from fenics_drill.model.discretization import DRIVE, THETA_X, THETA_Y, THETA_Z, U, V, W, BeamDiscretization
+from fenics_drill.model.discretization import THETA_X, THETA_Y, THETA_Z, U, V, W, BeamDiscretization
 from fenics_drill.model.operators import assemble_linear, assemble_modal_pair, field_mass_fractions
 
 KINDS = ("rigid", "flexural", "torsional", "axial")
@@ -215,14 +217,26 @@ def select_modes(basis: ModalBasis, scene) -> np.ndarray:
     return np.flatnonzero(keep)
 
 
-def stuck_bit_modes(disc: BeamDiscretization, f_star_max: float, mass) -> ModalBasis:
-    """Torsional modes of the string held by the drive and stuck at the bit (theta_x(L) held too): the
-    fixed-fixed waves n c_T / 2L that ring while the bit sticks (stick-slip, Section 6.9).  The modes of
+def stuck_bit_modes(disc: BeamDiscretization, f_star_max: float, mass, stiffness) -> ModalBasis:
+    """Torsional modes of the string held by the drive and stuck at the bit (theta_x held at both ends):
+    the fixed-fixed waves n c_T / 2L that ring while the bit sticks (stick-slip, Section 6.9).  The modes of
     the free bit alone reach the bit's stuck state only through many of them; with these, the basis
     spans both phases, as the fixed-interface modes of Craig & Bampton (1968) with the static bit
-    responses of the guard as constraint modes."""
-    modes = solve_modes(disc, f_star_max, mass, held=(*DRIVE, (THETA_X, 1)))
-    return modes.select(np.flatnonzero(np.array(modes.kinds) == "torsional"))
+    responses of the guard as constraint modes.  Torsion is uncoupled from the other fields in the
+    linear operators (46), so the theta_x block alone is solved (dense, a few hundred dofs)."""
+    p = disc.properties
+    dofs = disc.field_dofs[THETA_X]
+    inner = np.setdiff1d(dofs, [disc.end_dof(THETA_X, 0), disc.end_dof(THETA_X, 1)])
+    K = sp.csr_matrix(stiffness)[inner][:, inner].toarray()
+    M = sp.csr_matrix(mass)[inner][:, inner].toarray()
+    omega_max = 2.0 * math.pi * f_star_max * p.longitudinal_wave_speed / p.length
+    eigenvalues, block = sla.eigh(K, M, subset_by_value=(0.0, omega_max**2))
+    vectors = np.zeros((disc.ndofs, eigenvalues.size))
+    vectors[inner] = block  # M-orthonormal: eigh normalises block^T M block = I
+    freqs = np.sqrt(eigenvalues) / (2.0 * math.pi)
+    fractions = field_mass_fractions(mass, disc.field_of_dof, vectors)
+    return ModalBasis(freqs, freqs * p.length / p.longitudinal_wave_speed, ["torsional"] * eigenvalues.size,
+                      fractions, vectors)
 
 
 def family_counts(kinds) -> dict[str, int]:

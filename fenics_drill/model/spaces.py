@@ -172,7 +172,7 @@ def solution_space(scene, disc: BeamDiscretization, operators: LinearOperators):
     basis = modes.select(select_modes(modes, scene))
     vectors, stuck = basis.vectors, None
     if scene.reduction.rule == "auto" and scene.model.bit_rock:
-        stuck = stuck_bit_modes(disc, reduction_bands(scene)["torsional"], operators.mass)
+        stuck = stuck_bit_modes(disc, reduction_bands(scene)["torsional"], operators.mass, operators.stiffness)
         vectors = augment(vectors, stuck.vectors, operators.mass)
     drive = [disc.end_dof(U, 0), disc.end_dof(THETA_X, 0)]
     phi, guard = enrich(vectors, scene, disc, operators, lambda phi: phi[drive])

@@ -107,7 +107,8 @@ def test_modes_of_a_stuck_bit_are_the_fixed_fixed_torsional_waves():
     scene = scene_with("beam.elements=300")
     disc = BeamDiscretization.from_scene(scene)
     p = disc.properties
-    stuck = stuck_bit_modes(disc, 2.2, assemble_linear(disc).mass)
+    operators = assemble_linear(disc)
+    stuck = stuck_bit_modes(disc, 2.2, operators.mass, operators.stiffness)
     c_T = math.sqrt(p.shear_factor * p.shear_modulus / p.density)
     n = np.arange(1, len(stuck) + 1)
     assert set(stuck.kinds) == {"torsional"}
