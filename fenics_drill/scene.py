@@ -97,12 +97,15 @@ class Environment:
 class Contact:
     stiffness_linear: float = _nonneg("k_FS1 of Eq. (17) [N/m]", 1e10)
     stiffness_cubic: float = _nonneg("k_FS2 of Eq. (17) [N/m^3]", 1e16)
-    damping: float = _nonneg("c_FS of Eq. (17) [N s/m^4]", 1e6)
+    damping: float = _nonneg("c_FS of Eq. (17) [N s/m^4; N s^4/m^4 with damper_law = printed]", 1e6)
     friction: float = _nonneg("mu_FS of Eqs. (18)-(19) [-]", 0.25)
     axial_friction_law: str = key("model", "the axial friction (18): 'consistent', 'printed', or 'model' "
                                   "(as model.laws says)", choices=("model", "consistent", "printed"))
     friction_torque_law: str = key("model", "the friction torque (19): 'consistent', 'printed', or 'model' "
                                    "(as model.laws says)", choices=("model", "consistent", "printed"))
+    damper_law: str = key("consistent", "the damper of (17): 'consistent' (c |delta|^3 delta_dot, a force) or "
+                          "'printed' (c |delta_dot|^3 delta_dot as printed, not a force's unit: docs/errata.md), "
+                          "or 'model' (as model.laws says)", choices=("model", "consistent", "printed"))
     sliding_velocity_scale: float = _pos(
         "v_s of the regularised sgn(v) = tanh(v / v_s) in (18)-(19), applied to the axial velocity "
         "and to the surface speed R_bh theta_x_dot [m/s]", 1e-3)

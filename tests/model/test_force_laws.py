@@ -36,3 +36,19 @@ def test_hunt_crossley_damper_dissipates_and_has_force_units():
     assert approaching * rate < 0
     # receding, the bare damper would pull towards the wall: the law clips it to zero
     assert wall_contact.hunt_crossley_normal_force(delta, -rate, 0.0, 0.0, c) == 0.0
+
+
+def test_printed_damper_grows_with_the_impact_speed_and_still_dissipates():
+    """As printed, (17)'s damper is c |delta_dot|^3 delta_dot: independent of the indentation, quartic in
+    the speed, and opposing it; its derivatives are the closed forms 0 and -4 c |delta_dot|^3."""
+    c, rate = 1e6, np.array([-0.3, -1e-3, 0.0, 2e-2, 0.5])
+    for delta in (1e-6, 1e-3):
+        force, by_delta, by_rate = wall_contact.hunt_crossley_damper(delta, rate, c, "printed")
+        np.testing.assert_allclose(force, -c * np.abs(rate) ** 3 * rate, rtol=1e-14)
+        assert np.all(force * rate <= 0)
+        np.testing.assert_allclose(by_delta, 0.0)
+        np.testing.assert_allclose(by_rate, -4 * c * np.abs(rate) ** 3, rtol=1e-14)
+    # at an impact of 0.5 m/s and 0.1 mm indentation the printed damper is 10^12 times the consistent one
+    printed = wall_contact.hunt_crossley_damper(1e-4, 0.5, c, "printed")[0]
+    consistent = wall_contact.hunt_crossley_damper(1e-4, 0.5, c, "consistent")[0]
+    assert printed / consistent == pytest.approx(0.5**3 / 1e-12, rel=1e-12)

@@ -213,11 +213,13 @@ def test_energy_budget_closes_through_impacts_with_friction_and_rotation():
     assert sim.budget.balance_error < 1e-2
 
 
-@pytest.mark.parametrize("rule", ["count", "none"])  # dense modal basis, and the sparse full space
-def test_tangent_matches_finite_differences_with_contact_and_bit_rock(rule):
+@pytest.mark.parametrize("rule, laws", [("count", "consistent"), ("none", "consistent"), ("count", "printed")],
+                         ids=["dense modal basis", "sparse full space", "laws (17)-(19), (21) as printed"])
+def test_tangent_matches_finite_differences_with_contact_and_bit_rock(rule, laws):
     """The Newton tangent (forms + force laws) is the derivative of the residual."""
     scene = scene_with("beam.length=10.0", "beam.elements=20", f"reduction.rule='{rule}'",
-                       "reduction.flexural=12", "reduction.torsional=3", "reduction.axial=3")
+                       "reduction.flexural=12", "reduction.torsional=3", "reduction.axial=3",
+                       f"model.laws='{laws}'", f"contact.damper_law='{laws}'")
     model = build_model(scene)
     rng = np.random.default_rng(1)
     n = model.size

@@ -33,15 +33,30 @@ def indentation(v, w, gap):
     return np.hypot(v, w) - gap
 
 
-def hunt_crossley_normal_force(delta, delta_rate, stiffness_linear, stiffness_cubic, damping):
-    """Radial force on the string (<= 0: towards the axis), Eq. (17) with the damper c |delta|^3 delta_dot.
+def hunt_crossley_damper(delta, delta_rate, damping, law="consistent"):
+    """The damper of Eq. (17) and its derivatives (F_d, dF_d/d delta, dF_d/d delta_dot).
+
+    'consistent': -c |delta|^3 delta_dot, Hunt and Crossley's damper, a force with c in N s/m^4;
+    'printed': -c |delta_dot|^3 delta_dot as printed, which has no force's unit (docs/errata.md) and
+    grows with the impact speed instead of the indentation.  Both dissipate."""
+    delta, delta_rate = np.asarray(delta, dtype=float), np.asarray(delta_rate, dtype=float)
+    if law == "printed":
+        cubed = np.abs(delta_rate) ** 3
+        return -damping * cubed * delta_rate, np.zeros_like(delta), -4.0 * damping * cubed
+    cubed = np.abs(delta) ** 3
+    return -damping * cubed * delta_rate, -3.0 * damping * delta**2 * delta_rate, -damping * cubed
+
+
+def hunt_crossley_normal_force(delta, delta_rate, stiffness_linear, stiffness_cubic, damping, law="consistent"):
+    """Radial force on the string (<= 0: towards the axis), Eq. (17) with the damper of ``law``
+    (:func:`hunt_crossley_damper`).
 
     Zero out of contact, and clipped at zero so the damper never makes the wall pull.
     """
     delta = np.asarray(delta, dtype=float)
     in_contact = delta > 0
     d = np.where(in_contact, delta, 0.0)
-    force = -stiffness_linear * d - stiffness_cubic * d**3 - damping * np.abs(d) ** 3 * delta_rate
+    force = -stiffness_linear * d - stiffness_cubic * d**3 + hunt_crossley_damper(d, delta_rate, damping, law)[0]
     return np.where(in_contact, np.minimum(force, 0.0), 0.0)
 
 
@@ -92,14 +107,15 @@ class WallContact:
     }
 
     def __init__(self, disc: BeamDiscretization, space, contact, borehole_radius: float,
-                 law_sign: tuple[float, float] = (1.0, 1.0)):
+                 law_sign: tuple[float, float] = (1.0, 1.0), damper_law: str = "consistent"):
         """``contact``: the scene's [contact] section; ``law_sign``: +1 (consistent) or -1 (as printed) for
-        the axial friction (18) and the friction torque (19)."""
+        the axial friction (18) and the friction torque (19); ``damper_law``: the damper of (17)."""
         self.x = disc.vertex_x
         self.gap = borehole_radius - disc.properties.outer_radius
         self.borehole_radius = borehole_radius
         self.k1, self.k2 = contact.stiffness_linear, contact.stiffness_cubic
         self.c = contact.damping
+        self.damper_law = damper_law
         # the friction coefficient of each law, negative for a law taken as printed (scene.LAW_SIGN)
         self.mu_axial = law_sign[0] * contact.friction
         self.mu_torque = law_sign[1] * contact.friction
@@ -118,7 +134,7 @@ class WallContact:
     def from_scene(cls, scene, disc, space, operators) -> "WallContact":
         signs = (LAW_SIGN[scene.law(scene.contact.axial_friction_law)],
                  LAW_SIGN[scene.law(scene.contact.friction_torque_law)])
-        return cls(disc, space, scene.contact, scene.borehole.radius, signs)
+        return cls(disc, space, scene.contact, scene.borehole.radius, signs, scene.law(scene.contact.damper_law))
 
     def with_stiffness_scale(self, factor: float) -> "WallContact":
         """A copy whose wall springs k_FS1, k_FS2 are scaled by ``factor`` (the static continuation)."""
@@ -154,7 +170,7 @@ class WallContact:
         n_v, n_w = va / radius, wa / radius
         d = delta[active]
         d_rate = n_v * dv + n_w * dw
-        normal = hunt_crossley_normal_force(d, d_rate, self.k1, self.k2, self.c)
+        normal = hunt_crossley_normal_force(d, d_rate, self.k1, self.k2, self.c, self.damper_law)
         axial, torque = wall_friction(normal, du, dtx, self.mu_axial, self.borehole_radius, self.v_s, self.mu_torque)
         elastic = -self.k1 * d - self.k2 * d**3
         damper = normal - elastic  # the Hunt-Crossley damper, with the clip that keeps the wall from pulling
@@ -178,8 +194,9 @@ class WallContact:
     def _derivatives(self, active, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal) -> dict:
         """Pointwise derivatives of (F_a, F_v, F_w, T) w.r.t. vertex displacements and velocities."""
         pushing = normal < 0  # where the clip of (17) is active the force and its derivatives vanish
-        spring = np.where(pushing, -self.k1 - 3 * self.k2 * d**2 - 3 * self.c * d**2 * d_rate, 0.0)
-        damper = np.where(pushing, -self.c * d**3, 0.0)
+        _, damper_by_delta, damper_by_rate = hunt_crossley_damper(d, d_rate, self.c, self.damper_law)
+        spring = np.where(pushing, -self.k1 - 3 * self.k2 * d**2 + damper_by_delta, 0.0)
+        damper = np.where(pushing, damper_by_rate, 0.0)
         # d delta / d(v, w) = n ; d delta_rate / d(v, w) = (v_dot - delta_rate n) / r
         dFn_dv = spring * n_v + damper * (dv - d_rate * n_v) / radius
         dFn_dw = spring * n_w + damper * (dw - d_rate * n_w) / radius

@@ -1,0 +1,180 @@
+"""The paper's Section 6, as printed and consistent, side by side (issue 15; docs/reproduction.md).
+
+    python benchmarks/reproduction.py [--t-end 3] [--samples 32] [--ranks 2] [--runs out/reproduction]
+                                      [--table docs/reproduction_numbers.md] [--figures docs/figures/reproduction]
+
+Two models: ``consistent`` (demos/scenes/paper.toml, the defaults) and ``as_printed``
+(demos/scenes/paper_as_printed.toml: kinematics (14), angular velocity (13), laws (18), (19), (21) as
+printed, Table 4's basis).  For each: the nominal run (10 s; the as-printed one runs away after
+about 8 s: docs/reproduction.md), the three operating windows of
+demos/scenes/window_{efficiency,rop,robust}.toml and a Monte Carlo of --samples realisations, the
+windows and the Monte Carlo over --t-end seconds, on --ranks MPI processes.  Every study resumes
+where it stopped; a finished one is not run again.  Writes the numbers of the report into --table
+and copies the figures, named ``<figure>_<model>.png``, into --figures.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import subprocess
+import sys
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+MODELS = {"consistent": "demos/scenes/paper.toml", "as_printed": "demos/scenes/paper_as_printed.toml"}
+WINDOWS = ("efficiency", "rop", "robust")
+M_PER_H = 3600.0
+
+
+def _command(*args: str, ranks: int = 1) -> list[str]:
+    launcher = [str(Path(sys.executable).parent / "mpiexec"), "-n", str(ranks)] if ranks > 1 else []
+    return [*launcher, sys.executable, "-m", "fenics_drill.cli", *args]
+
+
+def _run(label: str, command: list[str], done: Path) -> float:
+    """Runs ``command`` unless ``done`` exists; returns its wall time (0 when skipped)."""
+    if done.exists():
+        return 0.0
+    print(f"[reproduction] {label}: {' '.join(command)}", flush=True)
+    start = time.perf_counter()
+    subprocess.run(command, check=False)
+    return time.perf_counter() - start
+
+
+def _window_overrides(window: str, t_end: float) -> list[str]:
+    """The [optimize] keys of demos/scenes/window_<window>.toml as --set overrides, over t_end."""
+    scene = tomllib.loads(Path(f"demos/scenes/window_{window}.toml").read_text())
+    sets = [f"optimize.{key}={json.dumps(value)}" for key, value in scene["optimize"].items()]
+    return [a for s in [*sets, f"time.t_end={t_end}"] for a in ("--set", s)]
+
+
+def studies(args) -> dict:
+    """Runs what is missing; returns {study: wall time [s]} of what ran now."""
+    costs = {}
+    for model, scene in MODELS.items():
+        nominal = args.runs / f"nominal-{model}"
+        costs[f"nominal-{model}"] = _run(f"nominal {model}", _command(
+            "run", scene, "--set", "time.t_end=10", "--quiet", "--overwrite", "--out", str(nominal)),
+            nominal / "fig14_bit_axial.png")
+        if not (nominal / "fig14_bit_axial.png").exists():
+            subprocess.run(_command("plot", str(nominal), "--no-gif"), check=False)
+        for window in WINDOWS:
+            out = args.runs / f"window-{window}-{model}"
+            costs[out.name] = _run(f"{window} window {model}", _command(
+                "optimize", scene, *_window_overrides(window, args.t_end), "--quiet", "--resume", "--out", str(out),
+                ranks=args.ranks), out / "optimize.json")
+            subprocess.run(_command("plot", str(out)), check=False)
+        out = args.runs / f"mc-{model}"
+        costs[out.name] = _run(f"Monte Carlo {model}", _command(
+            "mc", scene, "--samples", str(args.samples), "--set", f"time.t_end={args.t_end}", "--quiet", "--resume",
+            "--out", str(out), ranks=args.ranks), out / "statistics.h5")
+        subprocess.run(_command("plot", str(out)), check=False)
+    return costs
+
+
+def _nominal_row(summary: dict) -> dict:
+    bounce, slip = summary["bit_bounce"], summary["stick_slip"]
+    return {"mean bit velocity [m/h]": f"{summary['mean_bit_velocity'] * M_PER_H:.2f}",
+            "rop [m/h]": f"{summary['rop'] * M_PER_H:.2f}",
+            "bit off bottom": f"{bounce['off_bottom_fraction']:.1%}",
+            "bit velocity / mean": f"{bounce['velocity_min_ratio']:.0f} … {bounce['velocity_max_ratio']:.0f}",
+            "bit angular velocity / Ω": f"{slip['omega_min_ratio']:.1f} … {slip['omega_max_ratio']:.1f}",
+            "efficiency": f"{summary['efficiency']:.1%}",
+            "impacts": f"{summary['impacts_total']}", "shock packages": f"{summary['shock_packages']}",
+            "max σ_VM [MPa]": f"{summary['max_von_mises']['value'] / 1e6:.0f}",
+            "work of the printed laws [kJ]": ", ".join(
+                f"{k} {v / 1e3:.1f}" for k, v in summary["energy"]["injected_by"].items()) or "—",
+            "status": summary["status"], "steps": f"{summary['steps']}",
+            "wall time [s]": f"{summary['wall_time_s']:.0f}"}
+
+
+def _window_row(report: dict) -> dict:
+    v0, omega = np.asarray(report["axial_velocity"]), np.asarray(report["rotation_speed"])
+    best = report.get("optimum")
+    row = {"grid": f"{len(v0)} × {len(omega)}", "feasible": str(report.get("feasible"))}
+    if best:
+        row["grid optimum (V0 [m/h], Ω [rpm])"] = (f"({best['axial_velocity'] * M_PER_H:.0f}, "
+                                                  f"{best['rotation_speed'] * 30 / np.pi:.0f})")
+        row["objective at optimum"] = (f"{best['objective'] * M_PER_H:.1f} m/h" if report["objective"] == "rop"
+                                       else f"{best['objective']:.1%}")
+    for name, scale, unit in (("rop", M_PER_H, "m/h"), ("signed_rop", M_PER_H, "m/h"), ("efficiency", 100, "%"),
+                              ("max_von_mises", 1e-6, "MPa")):
+        values = np.asarray(report[name], dtype=float) * scale
+        if np.isfinite(values).any():
+            row[f"{name} range [{unit}]"] = f"{np.nanmin(values):.1f} … {np.nanmax(values):.1f}"
+    row["admissible points"] = f"{int(np.sum(report['admissible']))} of {np.size(report['admissible'])}"
+    row["failed runs"] = f"{report['failed_runs']}"
+    return row
+
+
+def _mc_row(summary: dict) -> dict:
+    row = {"realisations": f"{summary.get('realisations')}", "failed": f"{summary.get('failed')}",
+           "wall time per realisation [s]": f"{summary.get('wall_time_per_realisation_s', float('nan')):.0f}"}
+    for name, scale, unit in (("rop", M_PER_H, "m/h"), ("efficiency", 100, "%"), ("max_von_mises", 1e-6, "MPa")):
+        stats = summary.get(name)
+        if stats:
+            row[f"{name} [{unit}] mean (2.5 … 97.5 %)"] = (
+                f"{stats['mean'] * scale:.1f} ({stats['p2.5'] * scale:.1f} … {stats['p97.5'] * scale:.1f})")
+    return row
+
+
+def _table(title: str, rows: dict[str, dict]) -> list[str]:
+    keys = list(dict.fromkeys(k for row in rows.values() for k in row))
+    lines = [f"### {title}", "", "| | " + " | ".join(rows) + " |", "|---|" + "---|" * len(rows)]
+    lines += [f"| {k} | " + " | ".join(row.get(k, "—") for row in rows.values()) + " |" for k in keys]
+    return [*lines, ""]
+
+
+def write_report(args, costs: dict) -> None:
+    lines = ["# Section 6 reproduced: numbers (generated)", "",
+             f"Command: `python benchmarks/reproduction.py --t-end {args.t_end} --samples {args.samples} "
+             f"--ranks {args.ranks}`. Nominal runs 10 s; windows and Monte Carlo {args.t_end} s per run. Read with docs/reproduction.md.", ""]
+    nominal = {m: _nominal_row(json.loads((args.runs / f"nominal-{m}" / "summary.json").read_text()))
+               for m in MODELS}
+    lines += _table("Nominal run", nominal)
+    for window in WINDOWS:
+        rows = {m: _window_row(json.loads(p.read_text())) for m in MODELS
+                if (p := args.runs / f"window-{window}-{m}" / "optimize.json").exists()}
+        lines += _table(f"{window} window", rows)
+    rows = {m: _mc_row(json.loads(p.read_text())) for m in MODELS
+            if (p := args.runs / f"mc-{m}" / "summary.json").exists()}
+    lines += _table("Monte Carlo", rows)
+    ran = {k: v for k, v in costs.items() if v > 0}
+    if ran:
+        lines += ["### Wall time of the studies run by this invocation (2-core machine)", ""]
+        lines += [f"- {k}: {v:.0f} s" for k, v in ran.items()] + [""]
+    args.table.write_text("\n".join(lines))
+    print("\n".join(lines))
+
+
+def copy_figures(args) -> None:
+    args.figures.mkdir(parents=True, exist_ok=True)
+    for model in MODELS:
+        for study in args.runs.glob(f"*-{model}"):
+            for png in study.glob("*.png"):
+                prefix = study.name.removesuffix(f"-{model}").split("-")[0]
+                name = png.stem if prefix == "nominal" else f"{png.stem}_{study.name.removesuffix('-' + model)}"
+                shutil.copy(png, args.figures / f"{name}_{model}.png")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--t-end", type=float, default=3.0)
+    parser.add_argument("--samples", type=int, default=32)
+    parser.add_argument("--ranks", type=int, default=2)
+    parser.add_argument("--runs", type=Path, default=Path("out/reproduction"))
+    parser.add_argument("--table", type=Path, default=Path("docs/reproduction_numbers.md"))
+    parser.add_argument("--figures", type=Path, default=Path("docs/figures/reproduction"))
+    args = parser.parse_args()
+    costs = studies(args)
+    write_report(args, costs)
+    copy_figures(args)
+
+
+if __name__ == "__main__":
+    main()
