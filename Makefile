@@ -2,7 +2,7 @@
 PY := .venv/bin/python
 OUT ?= out
 
-.PHONY: setup demo demo-printed demo-as-printed test bench bench-ross campbell mc optimize stick-slip clean
+.PHONY: setup demo demo-printed demo-as-printed reproduction test bench bench-ross campbell mc optimize stick-slip clean
 
 setup:
 	@bash scripts/bootstrap.sh
@@ -29,6 +29,11 @@ demo-printed: setup
 demo-as-printed: setup
 	$(PY) -m fenics_drill.cli run demos/scenes/paper_as_printed.toml --set time.t_end=$(T_END) --overwrite --out $(OUT)/as-printed
 	$(PY) -m fenics_drill.cli plot $(OUT)/as-printed
+
+## Section 6 as printed and consistent, side by side (docs/reproduction.md): the nominal runs, the three
+## windows and a Monte Carlo of each model on RANKS processes (about 70 min on 2 ranks); resumes where it stopped.
+reproduction: setup
+	$(PY) benchmarks/reproduction.py --ranks $(RANKS)
 
 ## The test suite (a few minutes on 2 cores).
 test: setup

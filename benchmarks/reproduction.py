@@ -26,7 +26,20 @@ from pathlib import Path
 
 import numpy as np
 
+from fenics_drill.io.timeseries import read_series
+from fenics_drill.observables.drilling_quantities import drilling_quantities
+from fenics_drill.plots.common import panels, save_figure
+
 MODELS = {"consistent": "demos/scenes/paper.toml", "as_printed": "demos/scenes/paper_as_printed.toml"}
+#: Nominal 10 s runs: the two models, and the as-printed one with one law changed (why it runs away).
+NOMINALS = {
+    "consistent": ("consistent laws (the default)", MODELS["consistent"], []),
+    "as_printed": ("every law as printed", MODELS["as_printed"], []),
+    "as_printed_bit_torque_consistent": ("as printed, but the bit torque (21) consistent", MODELS["as_printed"],
+                                         ["bit_rock.torque_law=consistent"]),
+    "as_printed_damper_printed": ("as printed, and the damper (17) as printed", MODELS["as_printed"],
+                                  ["contact.damper_law=printed"]),
+}
 WINDOWS = ("efficiency", "rop", "robust")
 M_PER_H = 3600.0
 
@@ -56,13 +69,14 @@ def _window_overrides(window: str, t_end: float) -> list[str]:
 def studies(args) -> dict:
     """Runs what is missing; returns {study: wall time [s]} of what ran now."""
     costs = {}
-    for model, scene in MODELS.items():
-        nominal = args.runs / f"nominal-{model}"
-        costs[f"nominal-{model}"] = _run(f"nominal {model}", _command(
-            "run", scene, "--set", "time.t_end=10", "--quiet", "--overwrite", "--out", str(nominal)),
-            nominal / "fig14_bit_axial.png")
+    for name, (_, scene, overrides) in NOMINALS.items():
+        nominal = args.runs / f"nominal-{name}"
+        sets = [a for o in ["time.t_end=10", *overrides] for a in ("--set", o)]
+        costs[nominal.name] = _run(f"nominal {name}", _command(
+            "run", scene, *sets, "--quiet", "--overwrite", "--out", str(nominal)), nominal / "fig14_bit_axial.png")
         if not (nominal / "fig14_bit_axial.png").exists():
             subprocess.run(_command("plot", str(nominal), "--no-gif"), check=False)
+    for model, scene in MODELS.items():
         for window in WINDOWS:
             out = args.runs / f"window-{window}-{model}"
             costs[out.name] = _run(f"{window} window {model}", _command(
@@ -77,14 +91,18 @@ def studies(args) -> dict:
     return costs
 
 
-def _nominal_row(summary: dict) -> dict:
+def _nominal_row(directory: Path) -> dict:
+    summary = json.loads((directory / "summary.json").read_text())
+    data, attrs = read_series(directory / "timeseries.h5")
+    quantities = drilling_quantities(data, attrs["scene"].drive.axial_velocity, attrs["scene"].drive.rotation_speed)
     bounce, slip = summary["bit_bounce"], summary["stick_slip"]
     return {"mean bit velocity [m/h]": f"{summary['mean_bit_velocity'] * M_PER_H:.2f}",
             "rop [m/h]": f"{summary['rop'] * M_PER_H:.2f}",
             "bit off bottom": f"{bounce['off_bottom_fraction']:.1%}",
             "bit velocity / mean": f"{bounce['velocity_min_ratio']:.0f} … {bounce['velocity_max_ratio']:.0f}",
             "bit angular velocity / Ω": f"{slip['omega_min_ratio']:.1f} … {slip['omega_max_ratio']:.1f}",
-            "efficiency": f"{summary['efficiency']:.1%}",
+            "efficiency (96)-(98)": f"{summary['efficiency']:.1%}",
+            "efficiency, bit torque by its magnitude": f"{quantities['efficiency_torque_magnitude']:.1%}",
             "impacts": f"{summary['impacts_total']}", "shock packages": f"{summary['shock_packages']}",
             "max σ_VM [MPa]": f"{summary['max_von_mises']['value'] / 1e6:.0f}",
             "work of the printed laws [kJ]": ", ".join(
@@ -130,13 +148,34 @@ def _table(title: str, rows: dict[str, dict]) -> list[str]:
     return [*lines, ""]
 
 
+def _spectra_lines(args) -> list[str]:
+    """The two highest peaks of every Section 6.8 signal, named against the free modes of the band and
+    against the modes with u and theta_x held at x = 0 by the drive (spectra.json of each nominal run)."""
+    lines = ["### Spectral peaks (Figs. 21-23): peak [Hz] → nearest free mode | nearest mode held by the drive",
+             "", "| signal | " + " | ".join(label for label, _, _ in NOMINALS.values()) + " |",
+             "|---|" + "---|" * len(NOMINALS)]
+    spectra = {name: json.loads(p.read_text()) if (p := args.runs / f"nominal-{name}" / "spectra.json").exists()
+               else {} for name in NOMINALS}
+    signals = dict.fromkeys(k for s in spectra.values() for k in s)
+    for signal in signals:
+        cells = []
+        for name in NOMINALS:
+            peaks = spectra[name].get(signal, {}).get("peaks", [])
+            cells.append("<br>".join(
+                f"{pk['frequency_hz']:.2f} → {pk['mode_frequency_hz']:.2f} {pk['mode_kind']} | "
+                f"{pk['held_mode_frequency_hz']:.2f} {pk['held_mode_kind']}" for pk in peaks[:2]) or "—")
+        lines.append(f"| {signal} (Fig. {next(s[signal]['figure'] for s in spectra.values() if signal in s)}) | "
+                     + " | ".join(cells) + " |")
+    return [*lines, ""]
+
+
 def write_report(args, costs: dict) -> None:
     lines = ["# Section 6 reproduced: numbers (generated)", "",
              f"Command: `python benchmarks/reproduction.py --t-end {args.t_end} --samples {args.samples} "
              f"--ranks {args.ranks}`. Nominal runs 10 s; windows and Monte Carlo {args.t_end} s per run. Read with docs/reproduction.md.", ""]
-    nominal = {m: _nominal_row(json.loads((args.runs / f"nominal-{m}" / "summary.json").read_text()))
-               for m in MODELS}
-    lines += _table("Nominal run", nominal)
+    nominal = {label: _nominal_row(args.runs / f"nominal-{name}") for name, (label, _, _) in NOMINALS.items()}
+    lines += _table("Nominal run, 10 s", nominal)
+    lines += _spectra_lines(args)
     for window in WINDOWS:
         rows = {m: _window_row(json.loads(p.read_text())) for m in MODELS
                 if (p := args.runs / f"window-{window}-{m}" / "optimize.json").exists()}
@@ -152,9 +191,28 @@ def write_report(args, costs: dict) -> None:
     print("\n".join(lines))
 
 
+def comparison_figure(args) -> Path:
+    """Bit velocity / V0, bit angular velocity / Omega and impacts per step of the nominal runs, stacked
+    (the as-printed run's runaway is clipped at the axes' limits)."""
+    fig, axes = panels(3, 2.6)
+    for name, (label, _, _) in NOMINALS.items():
+        data, attrs = read_series(args.runs / f"nominal-{name}" / "timeseries.h5")
+        drive, t = attrs["scene"].drive, data["time"]
+        axes[0].plot(t, data["bit_velocity"] / drive.axial_velocity, lw=0.5, label=label)
+        axes[1].plot(t, data["bit_angular_velocity"] / drive.rotation_speed, lw=0.5)
+        axes[2].plot(t, np.cumsum(data["impacts"]), lw=1.0)
+    axes[0].set(ylabel="u̇_bit / V0", ylim=(-150, 150))
+    axes[1].set(ylabel="ω_bit / Ω", ylim=(-30, 30))
+    axes[2].set(ylabel="impacts (cumulative)", xlabel="time [s]", yscale="symlog")
+    axes[0].legend(fontsize=7, loc="upper left")
+    axes[0].set_title("The paper's nominal scene, 10 s: consistent, as printed, and as printed with one law changed")
+    args.figures.mkdir(parents=True, exist_ok=True)
+    return save_figure(fig, args.figures / "nominal_comparison.png")
+
+
 def copy_figures(args) -> None:
     args.figures.mkdir(parents=True, exist_ok=True)
-    for model in MODELS:
+    for model in NOMINALS:
         for study in args.runs.glob(f"*-{model}"):
             for png in study.glob("*.png"):
                 prefix = study.name.removesuffix(f"-{model}").split("-")[0]
@@ -174,6 +232,7 @@ def main() -> None:
     costs = studies(args)
     write_report(args, costs)
     copy_figures(args)
+    comparison_figure(args)
 
 
 if __name__ == "__main__":

@@ -49,9 +49,14 @@ def input_power(drive_velocity, drive_spin, lambda_1, lambda_4):
     return positive(drive_velocity) * positive(-lambda_1) + positive(drive_spin) * positive(-lambda_4)
 
 
-def output_power(bit_velocity, bit_force, bit_angular_velocity, bit_torque):
-    """P_out of (97): u_dot_bit^+ (-F_BR)^+ + omega_bit^+ (-T_BR)^+ [W]."""
-    return positive(bit_velocity) * positive(-bit_force) + positive(bit_angular_velocity) * positive(-bit_torque)
+def output_power(bit_velocity, bit_force, bit_angular_velocity, bit_torque, torque_magnitude: bool = False):
+    """P_out of (97): u_dot_bit^+ (-F_BR)^+ + omega_bit^+ (-T_BR)^+ [W].
+
+    ``torque_magnitude``: omega_bit^+ |T_BR| in place of omega_bit^+ (-T_BR)^+.  With the bit torque (21)
+    as printed, T_BR drives the bit (T_BR omega_bit >= 0) and (-T_BR)^+ vanishes while it turns forward;
+    counting |T_BR| is how the paper's efficiency of about 16 % comes out (docs/reproduction.md)."""
+    rotational = np.abs(bit_torque) if torque_magnitude else positive(-bit_torque)
+    return positive(bit_velocity) * positive(-bit_force) + positive(bit_angular_velocity) * rotational
 
 
 def efficiency(t, p_in, p_out) -> float:
@@ -112,10 +117,11 @@ def drilling_quantities(series: dict, axial_velocity: float, rotation_speed: flo
     top_velocity = series.get("top_velocity", axial_velocity)
     top_spin = series.get("top_angular_velocity", rotation_speed)
     p_in = input_power(top_velocity, top_spin, series["lambda_1"], series["lambda_4"])
-    p_out = output_power(series["bit_velocity"], series["bit_force"], series["bit_angular_velocity"],
-                         series["bit_torque"])
+    bit = (series["bit_velocity"], series["bit_force"], series["bit_angular_velocity"], series["bit_torque"])
+    p_out = output_power(*bit)
     return {
         "efficiency": efficiency(t, p_in, p_out),
+        "efficiency_torque_magnitude": efficiency(t, p_in, output_power(*bit, torque_magnitude=True)),
         "rop": rop(t, series["bit_velocity"]),
         "signed_rop": signed_rop(t, series["bit_velocity"]),
         "mean_input_power": time_integral(t, p_in) / (t[-1] - t[0]),

@@ -46,6 +46,15 @@ class StepController:
         self.forced_steps = 0  # steps accepted at the minimum size although their error exceeded the tolerance
         self.worst_forced_ratio = 0.0
 
+    def step_towards(self, t: float, t_end: float) -> float:
+        """The next step from t: the proposal, except near t_end, where what is left is split into one or
+        two equal steps.  A sliver of a step (t_end - t << dt) would scale the Newmark inertia by
+        1/dt^2 and drown Newton's residual in round-off."""
+        remaining = t_end - t
+        if remaining > 2.0 * self.dt:
+            return self.dt
+        return remaining if remaining <= self.dt else 0.5 * remaining
+
     def error_ratio(self, dt: float, qdd_old: np.ndarray, qdd_new: np.ndarray) -> float:
         """Estimated local error over the tolerance (<= 1: accept)."""
         e = self.error_factor * dt * dt * (qdd_new - qdd_old)

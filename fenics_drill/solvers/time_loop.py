@@ -116,7 +116,7 @@ class Simulation:
         if on_step is not None:
             on_step(StepRecord(state, 0.0, 0, ev, np.zeros_like(in_contact), in_contact, budget, 0))
         while state.t < t_end * (1 - 1e-12):
-            dt = min(self.controller.dt, t_end - state.t)
+            dt = self.controller.step_towards(state.t, t_end)
             model.start_step(state.t + dt)
             try:
                 new, iterations, new_ev = self.stepper.step(state, dt, h0)

@@ -86,6 +86,20 @@ def test_efficiency_is_output_over_input_work_of_eqs_96_to_98():
     # u_dot_bit > 0 throughout and the sinusoid integrates to zero over whole periods
     assert q["efficiency"] == pytest.approx((v0 * 3e4 + omega * 2e3) / (v0 * 4e4 + omega * 9e3), rel=1e-7)
     assert q["mean_input_power"] == pytest.approx(v0 * 4e4 + omega * 9e3, rel=1e-12)
+    # the bit torque's magnitude counts the same while the torque resists the spin
+    assert q["efficiency_torque_magnitude"] == pytest.approx(q["efficiency"], rel=1e-12)
+
+
+def test_a_torque_that_drives_the_bit_adds_nothing_to_97_but_counts_by_its_magnitude():
+    """With the bit torque (21) as printed, T_BR omega_bit > 0: (-T_BR)^+ = 0, so (97) keeps the axial
+    power alone, while omega^+ |T_BR| counts it as the resisting torque would."""
+    v0, omega = 0.005, 6.0
+    t, series = synthetic_run(v0, omega)
+    series["bit_torque"] = -series["bit_torque"]
+    q = dq.drilling_quantities(series, v0, omega)
+    work_in = v0 * 4e4 + omega * 9e3
+    assert q["efficiency"] == pytest.approx(v0 * 3e4 / work_in, rel=1e-7)
+    assert q["efficiency_torque_magnitude"] == pytest.approx((v0 * 3e4 + omega * 2e3) / work_in, rel=1e-7)
 
 
 def test_rop_takes_the_positive_part_and_the_signed_variant_does_not():
