@@ -17,7 +17,8 @@ import h5py
 from fenics_drill.io.files import UnreadableFile, write_atomic
 
 #: Scalars kept per realisation.
-SCALARS = ("rop", "efficiency", "signed_rop", "mean_bit_velocity", "max_von_mises", "q_norm_integral")
+SCALARS = ("rop", "efficiency", "efficiency_torque_magnitude", "signed_rop", "mean_bit_velocity", "max_von_mises",
+           "q_norm_integral")
 #: The realisation with the nominal bit-rock law.
 NOMINAL = "nominal.h5"
 

@@ -63,7 +63,8 @@ def _evaluate(prepared, scene, v0: float, omega: float, bit_rock: dict) -> dict:
     point_scene = scene.with_changes(drive={"axial_velocity": v0, "rotation_speed": omega}, bit_rock=bit_rock)
     r = run_realisation(prepared, point_scene)
     return {"status": r["status"], "message": r["message"], "rop": r["rop"], "signed_rop": r["signed_rop"],
-            "efficiency": r["efficiency"], "max_von_mises": r["max_von_mises"], "bit_rock": bit_rock,
+            "efficiency": r["efficiency"], "efficiency_torque_magnitude": r["efficiency_torque_magnitude"],
+            "max_von_mises": r["max_von_mises"], "bit_rock": bit_rock,
             **{key: r[key] for key in OSCILLATIONS},
             "wall_time_s": r["wall_time_s"]}
 
@@ -92,7 +93,8 @@ def assemble(scene, out: Path) -> dict:
     v0, omega = grid_axis(opt.axial_velocity), grid_axis(opt.rotation_speed)
     draws = [NOMINAL_DRAW] if opt.samples == 0 else list(range(opt.samples))
     shape = (len(v0), len(omega))
-    maps = {key: np.full(shape, np.nan) for key in ("rop", "signed_rop", "efficiency", "max_von_mises",
+    maps = {key: np.full(shape, np.nan) for key in ("rop", "signed_rop", "efficiency", "efficiency_torque_magnitude",
+                                                     "max_von_mises",
                                                      "constraint_probability", *OSCILLATIONS)}
     failed = 0
     for i in range(len(v0)):
@@ -102,7 +104,7 @@ def assemble(scene, out: Path) -> dict:
             failed += len(results) - len(finished)
             if not finished:
                 continue
-            for key in ("rop", "signed_rop", "efficiency", *OSCILLATIONS):
+            for key in ("rop", "signed_rop", "efficiency", "efficiency_torque_magnitude", *OSCILLATIONS):
                 # E[.] of (102); the value itself if N = 0 (results of earlier versions lack the oscillations)
                 maps[key][i, j] = np.mean([r.get(key, np.nan) for r in finished])
             stresses = np.array([r["max_von_mises"] for r in finished])

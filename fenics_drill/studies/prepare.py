@@ -162,6 +162,7 @@ def run_realisation(prepared: PreparedScene, scene) -> dict:
     q = drilling_quantities(series, drive.axial_velocity, drive.rotation_speed) if len(t) > 1 else {}
     result["rop"], result["efficiency"] = q.get("rop", np.nan), q.get("efficiency", np.nan)
     result["signed_rop"] = q.get("signed_rop", np.nan)
+    result["efficiency_torque_magnitude"] = q.get("efficiency_torque_magnitude", np.nan)
     result["mean_bit_velocity"] = (series["bit_displacement"][-1] - series["bit_displacement"][0]) / t[-1] \
         if t[-1] > 0 else np.nan
     result.update(_oscillation_indicators(series, drive.axial_velocity, drive.rotation_speed))

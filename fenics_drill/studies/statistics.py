@@ -61,8 +61,10 @@ def write_statistics(out: Path, samples: int) -> dict:
         raise RuntimeError(f"none of the {samples} realisations finished; see their messages in {out}/realisations")
     nominal = read_realisation(out / NOMINAL)
     time = ok[0]["time"]
-    scalars = {key: np.array([r[key] for r in ok], dtype=float)
-               for key in ("rop", "efficiency", "signed_rop", "mean_bit_velocity", "max_von_mises")}
+    # (realisations of earlier versions lack efficiency_torque_magnitude: NaN, left out of its summary)
+    scalars = {key: np.array([r.get(key, np.nan) for r in ok], dtype=float)
+               for key in ("rop", "efficiency", "efficiency_torque_magnitude", "signed_rop", "mean_bit_velocity",
+                           "max_von_mises")}
     conv = convergence_metric(np.array([r["q_norm_integral"] for r in ok]))
     with h5py.File(out / "statistics.h5", "w") as f:
         f.attrs["realisations"] = len(ok)
@@ -95,7 +97,7 @@ def write_statistics(out: Path, samples: int) -> dict:
             f[f"scalars/{key}"] = values
     summary = {
         "realisations": len(ok), "failed": len(results) - len(ok), "convergence_metric": float(conv[-1]),
-        "nominal": {key: float(nominal[key]) for key in scalars},
+        "nominal": {key: float(nominal.get(key, np.nan)) for key in scalars},
         **{key: _scalar_summary(values) for key, values in scalars.items()},
         "wall_time_per_realisation_s": float(np.mean([r["wall_time_s"] for r in results])),
     }

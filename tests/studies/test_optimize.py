@@ -32,7 +32,7 @@ def test_grid_values_are_those_of_separate_runs(window, tmp_path):
         assert main(["run", *TINY, *EXACT, "--set", f"drive.axial_velocity={v0}", "--set", "drive.rotation_speed=5.0",
                      "--quiet", "--out", str(run_dir)]) == 0
         summary = json.loads((run_dir / "summary.json").read_text())
-        for key in ("rop", "efficiency", "signed_rop"):
+        for key in ("rop", "efficiency", "efficiency_torque_magnitude", "signed_rop"):
             assert report[key][i][0] == pytest.approx(summary[key], rel=1e-12), key
         assert report["max_von_mises"][i][0] == pytest.approx(summary["max_von_mises"]["value"], rel=1e-12)
 
