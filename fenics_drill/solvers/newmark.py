@@ -43,6 +43,10 @@ def newmark_parameters(alpha: float) -> tuple[float, float]:
     return gamma, 0.25 * (0.5 + gamma) ** 2
 
 
+#: Relative round-off of a displacement, in units of machine epsilon's worth of cancellations.
+ROUND_OFF = 1e3 * np.finfo(float).eps
+
+
 class NewmarkNewton:
     """One Newmark step of (65) with the constraints (72) enforced by multipliers."""
 
@@ -116,7 +120,10 @@ class NewmarkNewton:
             # accepted before (never against a predictor's residual: an explosive predictor would make
             # any iterate look converged)
             scale = self._scale(ev, self.model.constraints.T @ mu, self.model.mass @ rates(q)[1])
-            if norm <= self.tolerance * max(self._force_level, scale) and np.all(
+            # the inertia M (q - q_pred) / (beta dt^2) cannot be known better than round-off in q: a string
+            # that only spins, unloaded, has nothing else to measure its residual against
+            floor = ROUND_OFF * c_a * float(np.linalg.norm(self.model.mass @ q))
+            if norm <= max(self.tolerance * max(self._force_level, scale), floor) and np.all(
                 np.abs(gap) <= self.tolerance * np.maximum(np.abs(target), 1.0)
             ):
                 self._force_level = max(self._force_level, scale)

@@ -292,3 +292,19 @@ def test_a_run_reaches_t_end_without_a_sliver_step(sliver):
     assert last.t == pytest.approx(t_end, rel=1e-12)
     assert min(steps[1:]) >= 0.5 * dt * (1 - 1e-12)
     assert sim.budget.balance_error < 1e-6  # alpha = 0, no damping: the drive's work is the energy change
+
+
+def test_an_unloaded_string_that_only_spins_keeps_its_rigid_spin():
+    """Nothing but the drive's spin: no load anywhere, so every force is round-off. Newton converges
+    against the round-off of the Newmark inertia (it used to fail at t = 0), the string turns rigidly
+    at Omega, and no energy is made: E(t) - E(0) = W_drive = 0."""
+    scene = short_scene("beam.damping=0.0", "time.newmark_alpha=0.0", "time.adaptive=false",
+                        "reduction.rule='count'", "reduction.flexural=8", "reduction.torsional=2",
+                        "reduction.axial=2", "drive.rotation_speed=6.283185307179586")
+    model = build_model(scene)
+    sim = Simulation(model, scene.with_changes(time={"dt": 1e-3, "t_end": 2e-2}))
+    last = sim.run(sim.initial_state(np.zeros(model.size)), 2e-2)
+    spin = model.bit_state(last.q, last.qd)
+    assert spin[2] == pytest.approx(2 * math.pi * last.t, rel=1e-9)  # theta_x(L) = Omega t
+    assert spin[3] == pytest.approx(2 * math.pi, rel=1e-9)  # omega_bit = Omega
+    assert abs(sim.budget.summary()["input_work"]) < 1e-9
