@@ -131,7 +131,19 @@ def _nominal_row(directory: Path, t_first: float) -> dict:
             "wall time [s]": f"{summary['wall_time_s']:.0f}", **_first_seconds(data, drive, t_first)}
 
 
-def _window_row(report: dict) -> dict:
+def _realisation_spread(points: Path) -> str:
+    """Across the realisations of each point of a robust window: the widest range of rop [m/h]."""
+    by_point: dict[str, list[float]] = {}
+    for path in sorted(points.glob("*_[0-9]*.json")):
+        result = json.loads(path.read_text())
+        if result["status"] == "finished":
+            by_point.setdefault(path.name[:4], []).append(result["rop"] * M_PER_H)
+    widest = max(by_point.values(), key=lambda r: max(r) - min(r))
+    return f"{min(widest):.1f} … {max(widest):.1f}"
+
+
+def _window_row(directory: Path) -> dict:
+    report = json.loads((directory / "optimize.json").read_text())
     v0, omega = np.asarray(report["axial_velocity"]), np.asarray(report["rotation_speed"])
     best = report.get("optimum")
     row = {"grid": f"{len(v0)} × {len(omega)}", "feasible": str(report.get("feasible"))}
@@ -147,6 +159,8 @@ def _window_row(report: dict) -> dict:
             row[f"{name} range [{unit}]"] = f"{np.nanmin(values):.1f} … {np.nanmax(values):.1f}"
     row["admissible points"] = f"{int(np.sum(report['admissible']))} of {np.size(report['admissible'])}"
     row["failed runs"] = f"{report['failed_runs']}"
+    if report["mode"].startswith("robust"):
+        row["widest rop range over one point's realisations [m/h]"] = _realisation_spread(directory / "points")
     return row
 
 
@@ -198,8 +212,8 @@ def write_report(args, costs: dict) -> None:
     lines += _table("Nominal run, 10 s", nominal)
     lines += _spectra_lines(args)
     for window in WINDOWS:
-        rows = {m: _window_row(json.loads(p.read_text())) for m in MODELS
-                if (p := args.runs / f"window-{window}-{m}" / "optimize.json").exists()}
+        rows = {m: _window_row(d) for m in MODELS
+                if ((d := args.runs / f"window-{window}-{m}") / "optimize.json").exists()}
         lines += _table(f"{window} window", rows)
     rows = {m: _mc_row(json.loads(p.read_text())) for m in MODELS
             if (p := args.runs / f"mc-{m}" / "summary.json").exists()}
