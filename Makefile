@@ -24,7 +24,7 @@ demo-printed: setup
 
 ## Every law as printed (kinematics (14), friction (18)-(19), bit torque (21)): the paper's Figs. 14-23 as
 ## published (demos/scenes/paper_as_printed.toml; docs/errata.md says why these laws are not the default).
-## Over the full 10 s the as-printed model runs away after about 6 s (docs/reproduction.md): T_END=3 shows
+## Over the full 10 s the as-printed model runs away after about 8 s (docs/reproduction.md): T_END=3 shows
 ## the published phenomena before it.
 demo-as-printed: setup
 	$(PY) -m fenics_drill.cli run demos/scenes/paper_as_printed.toml --set time.t_end=$(T_END) --overwrite --out $(OUT)/as-printed

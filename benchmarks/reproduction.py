@@ -247,13 +247,20 @@ def comparison_figure(args) -> Path:
     return save_figure(fig, args.figures / "nominal_comparison.png")
 
 
+#: The figures the report shows: all of a model's, the time histories of a variant.
+VARIANT_FIGURES = ("fig14_bit_axial", "fig15_bit_rotation", "fig18_impacts_time")
+
+
 def copy_figures(args) -> None:
+    """The studies' figures into --figures as <figure>[_<study>]_<model>.png."""
     args.figures.mkdir(parents=True, exist_ok=True)
     for model in NOMINALS:
         for study in args.runs.glob(f"*-{model}"):
-            for png in study.glob("*.png"):
-                prefix = study.name.removesuffix(f"-{model}").split("-")[0]
-                name = png.stem if prefix == "nominal" else f"{png.stem}_{study.name.removesuffix('-' + model)}"
+            kind = study.name.removesuffix(f"-{model}")
+            for png in study.glob("fig*.png"):
+                if model not in MODELS and png.stem not in VARIANT_FIGURES:
+                    continue
+                name = png.stem if kind == "nominal" else f"{png.stem}_{kind}"
                 shutil.copy(png, args.figures / f"{name}_{model}.png")
 
 
