@@ -20,6 +20,9 @@ from fenics_drill.solvers.newton import saddle_newton
 #: A Newton iterate keeps the tangent of the previous one while the residual shrinks at least this much
 #: per update (the stiff bit and wall laws make it rarely so in their transients: then it is fresh).
 TANGENT_REUSE_RATE = 0.1
+#: A Newton update that shrinks the residual less than this (where a consistent tangent gives quadratic
+#: convergence) has the internal tangent of earlier steps assembled afresh for the next one.
+SLOW_CONTRACTION = 0.25
 
 
 class NewtonFailure(RuntimeError):
@@ -114,6 +117,7 @@ class NewmarkNewton:
             return ev
 
         def check(iteration, q, mu, ev, norm, gap):
+            norms.append(norm)
             if not np.isfinite(norm):
                 raise NewtonFailure(f"Newton produced non-finite values at dt = {dt:.3e} s")
             # the residual is measured against the forces that balance at this iterate and at the states
@@ -135,7 +139,17 @@ class NewmarkNewton:
         mu = state.mu.copy()
         stale = self._internal_parts is None or self._steps_since_tangent >= self.tangent_reuse
         ev = evaluate(q, mu, stale and self.model.internal.state_dependent)
-        result = saddle_newton(lambda q, mu: evaluate(q, mu), self.model.space, self.model.constraints, target,
+        norms = []  # the residual norm of every iterate of this step, as check sees them
+
+        def trial(q, mu):
+            """An iterate's evaluation.  Newton that contracts slowly although its tangent is fresh has an
+            internal tangent of earlier steps that drifted (the large deflections of a full-order string):
+            the next evaluation assembles it afresh, once per step."""
+            slow = len(norms) >= 2 and norms[-1] > SLOW_CONTRACTION * norms[-2]
+            stale = self._steps_since_tangent > 0 and self.model.internal.state_dependent
+            return evaluate(q, mu, refresh=slow and stale)
+
+        result = saddle_newton(trial, self.model.space, self.model.constraints, target,
                                q, mu, ev, check, self.max_iterations, reuse_rate=TANGENT_REUSE_RATE)
         if result is None:
             raise NewtonFailure(f"Newton did not converge in {self.max_iterations} iterations at dt = {dt:.3e} s")
