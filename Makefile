@@ -31,7 +31,7 @@ demo-as-printed: setup
 	$(PY) -m fenics_drill.cli plot $(OUT)/as-printed
 
 ## Section 6 as printed and consistent, side by side (docs/reproduction.md): the nominal runs, the three
-## windows and a Monte Carlo of each model on RANKS processes (about 70 min on 2 ranks); resumes where it stopped.
+## windows and a Monte Carlo of each model on RANKS processes (about 50 min on 2 ranks); resumes where it stopped.
 reproduction: setup
 	$(PY) benchmarks/reproduction.py --ranks $(RANKS)
 
