@@ -42,6 +42,7 @@ def test_printed_damper_grows_with_the_impact_speed_and_still_dissipates():
     """As printed, (17)'s damper is c |delta_dot|^3 delta_dot: independent of the indentation, quartic in
     the speed, and opposing it; its derivatives are the closed forms 0 and -4 c |delta_dot|^3."""
     c, rate = 1e6, np.array([-0.3, -1e-3, 0.0, 2e-2, 0.5])
+    # the same arithmetic as the law, a few float operations apart: 1e-14 is round-off
     for delta in (1e-6, 1e-3):
         force, by_delta, by_rate = wall_contact.hunt_crossley_damper(delta, rate, c, "printed")
         np.testing.assert_allclose(force, -c * np.abs(rate) ** 3 * rate, rtol=1e-14)
@@ -51,4 +52,4 @@ def test_printed_damper_grows_with_the_impact_speed_and_still_dissipates():
     # at an impact of 0.5 m/s and 0.1 mm indentation the printed damper is 10^12 times the consistent one
     printed = wall_contact.hunt_crossley_damper(1e-4, 0.5, c, "printed")[0]
     consistent = wall_contact.hunt_crossley_damper(1e-4, 0.5, c, "consistent")[0]
-    assert printed / consistent == pytest.approx(0.5**3 / 1e-12, rel=1e-12)
+    assert printed / consistent == pytest.approx(0.5**3 / 1e-12, rel=1e-12)  # a ratio of two products: round-off

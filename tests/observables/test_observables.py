@@ -86,7 +86,8 @@ def test_efficiency_is_output_over_input_work_of_eqs_96_to_98():
     # u_dot_bit > 0 throughout and the sinusoid integrates to zero over whole periods
     assert q["efficiency"] == pytest.approx((v0 * 3e4 + omega * 2e3) / (v0 * 4e4 + omega * 9e3), rel=1e-7)
     assert q["mean_input_power"] == pytest.approx(v0 * 4e4 + omega * 9e3, rel=1e-12)
-    # the bit torque's magnitude counts the same while the torque resists the spin
+    # the bit torque's magnitude counts the same while the torque resists the spin: identical integrands, so
+    # only the order of the summation differs (1e-12)
     assert q["efficiency_torque_magnitude"] == pytest.approx(q["efficiency"], rel=1e-12)
 
 
@@ -98,6 +99,8 @@ def test_a_torque_that_drives_the_bit_adds_nothing_to_97_but_counts_by_its_magni
     series["bit_torque"] = -series["bit_torque"]
     q = dq.drilling_quantities(series, v0, omega)
     work_in = v0 * 4e4 + omega * 9e3
+    # 1e-7, as in the test above: the trapezoidal rule integrates the sinusoid to zero over whole periods only
+    # up to the sampling of synthetic_run
     assert q["efficiency"] == pytest.approx(v0 * 3e4 / work_in, rel=1e-7)
     assert q["efficiency_torque_magnitude"] == pytest.approx((v0 * 3e4 + omega * 2e3) / work_in, rel=1e-7)
 
