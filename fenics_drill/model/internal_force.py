@@ -95,7 +95,7 @@ class AssembledInternalForce:
             weight = fem.Function(fem.functionspace(disc.mesh, ("DG", 0)))
             weight.x.array[cells] = sample.weights
             self.weight = weight
-            self.dofs = np.unique(disc.V.dofmap.list[cells])  # the dofs the sampled cells touch
+            self.dofs = np.unique(disc.V.dofmap.list[cells]).astype(PETSc.IntType)  # the dofs the sampled cells touch
             self.phi_rows = space.phi[self.dofs]
 
         def forces(geometric, inertial):
@@ -160,10 +160,11 @@ class AssembledInternalForce:
         self._matrix.zeroEntries()
         fem_petsc.assemble_matrix(self._matrix, self._jacobian)
         self._matrix.assemble()
-        tangent = self.space.project_matrix(petsc_to_scipy(self._matrix))
-        if self.dofs is not None:
-            tangent = tangent + sum(c * m for c, m in zip((c_u, c_v, c_a), self.linear) if c != 0)
-        return tangent
+        if self.dofs is None:
+            return self.space.project_matrix(petsc_to_scipy(self._matrix))
+        block = self._matrix.getValues(self.dofs, self.dofs)  # the sampled cells touch these dofs only
+        return self.phi_rows.T @ block @ self.phi_rows + sum(c * m for c, m in zip((c_u, c_v, c_a), self.linear)
+                                                              if c != 0)
 
     def tangent_parts(self, needed=(True, True, True)):
         """(df/dq, df/dqd, df/dqdd) at the state of the last :meth:`evaluate`; None for a part not

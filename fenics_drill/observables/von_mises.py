@@ -56,24 +56,49 @@ class VonMisesProbe:
         self.cells = np.arange(disc.mesh.topology.index_map(1).size_local, dtype=np.int32)
         y, z = outer_fibre(p.outer_radius).T
         self.monomials = np.stack([y**a * z**b for a, b in MONOMIALS])  # (6, samples)
+        # max |y^a z^b| on the circle r = R_ext: R^(a+b) times max |cos^a sin^b| (1 or 1/2 for a = b = 1)
+        self.monomial_bounds = np.array([p.outer_radius ** (a + b) * (0.5 if a == b == 1 else 1.0)
+                                         for a, b in MONOMIALS])
         x = disc.mesh.geometry.x[:, 0]
         cell_vertices = disc.mesh.geometry.dofmaps[0]  # (cells, 2) for the affine interval
         x0, x1 = x[cell_vertices[:, 0]], x[cell_vertices[:, 1]]
         self.x = x0[:, None] + ELEMENT_POINTS[:, 0][None, :] * (x1 - x0)[:, None]  # (cells, points)
 
+    def _coefficients(self, dofs: np.ndarray) -> np.ndarray:
+        """Monomial coefficients of (eps_xx, eps_xy, eps_xz) at every point: (cells * points, 3, 6)."""
+        self.field.x.array[:] = dofs
+        return self.expression.eval(self.mesh, self.cells).reshape(-1, 3, len(MONOMIALS))
+
+    def _squared(self, c: np.ndarray) -> np.ndarray:
+        """sigma_VM^2 on the outer fibre at the points of ``c`` (points, 3, 6): (points, samples)."""
+        exx, exy, exz = (c[:, i] @ self.monomials for i in range(3))
+        return self.E**2 * exx**2 + 12.0 * self.G**2 * (exy**2 + exz**2)
+
+    def _bound(self, c: np.ndarray) -> np.ndarray:
+        """An upper bound of sigma_VM^2 over the whole outer fibre at every point of ``c``: each strain
+        is bounded by the sum of its monomials' largest magnitudes on the circle r = R_ext."""
+        exx, exy, exz = (np.abs(c[:, i]) @ self.monomial_bounds for i in range(3))
+        return self.E**2 * exx**2 + 12.0 * self.G**2 * (exy**2 + exz**2)
+
     def stress(self, dofs: np.ndarray) -> np.ndarray:
         """Maximum of sigma_VM over each sampled section, shape (cells, points) [Pa]."""
-        self.field.x.array[:] = dofs
-        c = self.expression.eval(self.mesh, self.cells).reshape(-1, 3, len(MONOMIALS))
-        exx, exy, exz = (c[:, i] @ self.monomials for i in range(3))  # (cells * points, samples)
-        squared = self.E**2 * exx**2 + 12.0 * self.G**2 * (exy**2 + exz**2)
+        squared = self._squared(self._coefficients(dofs))
         return np.sqrt(squared.max(axis=1)).reshape(len(self.cells), len(ELEMENT_POINTS))
 
     def maximum(self, dofs: np.ndarray) -> tuple[float, float]:
-        """(max sigma_VM [Pa], x where it occurs [m]) over the whole string."""
-        s = self.stress(dofs)
-        k = int(np.argmax(s))
-        return float(s.flat[k]), float(self.x.flat[k])
+        """(max sigma_VM [Pa], x where it occurs [m]) over the whole string.
+
+        The same maximum as :meth:`stress`, at a fraction of its cost: the sections are sampled only
+        where the bound of :meth:`_bound` reaches the stress sampled at the section of largest bound."""
+        c = self._coefficients(dofs)
+        bound = self._bound(c)
+        first = int(np.argmax(bound))
+        # (1 - 1e-9): the bound and the sampled stress are equal where one monomial carries the strain,
+        # and round-off must not drop that section
+        candidates = np.flatnonzero(bound >= (1.0 - 1e-9) * self._squared(c[first:first + 1]).max())
+        squared = self._squared(c[candidates]).max(axis=1)
+        k = int(candidates[np.argmax(squared)])
+        return float(np.sqrt(squared.max())), float(self.x.flat[k])
 
     def cell_stress(self, dofs: np.ndarray) -> np.ndarray:
         """Maximum of sigma_VM over each element (for field output and pictures) [Pa]."""

@@ -63,6 +63,21 @@ def test_von_mises_of_pure_bending_is_e_kappa_r_plus_the_green_lagrange_stretch(
     assert where == pytest.approx(L)
 
 
+def test_the_pruned_maximum_is_the_maximum_over_every_sampled_section(disc):
+    """maximum() samples only the sections whose bound reaches a sampled stress; on random states of
+    every field (bending, torsion, shear, stretch mixed) it must find exactly what sampling every
+    section finds (the same arithmetic on the same points: equal to round-off)."""
+    rng = np.random.default_rng(7)
+    probe = VonMisesProbe(disc)
+    for _ in range(20):
+        dofs = 1e-3 * rng.normal(size=disc.ndofs) * rng.uniform(0.0, 1.0, size=disc.ndofs) ** 4
+        value, where = probe.maximum(dofs)
+        everywhere = probe.stress(dofs)
+        k = int(np.argmax(everywhere))
+        assert value == pytest.approx(everywhere.flat[k], rel=1e-14)
+        assert where == probe.x.flat[k]
+
+
 #: A threshold crossing is located to one sample: two crossings per period of 1000 samples.
 CROSSING = 2.0 / 1000
 

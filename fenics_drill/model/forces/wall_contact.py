@@ -11,6 +11,7 @@ for the Newton tangent.
 from __future__ import annotations
 
 import copy
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -80,6 +81,35 @@ def wall_friction(normal_force, axial_velocity, spin_rate, friction, borehole_ra
     return force, torque
 
 
+class ProjectedLaws(Mapping):
+    """The generalised forces of the non-conservative wall laws (the damper of (17), (18), (19)),
+    projected on first use: the energy budget reads them at accepted steps only, not at Newton's
+    iterates."""
+
+    NAMES = ("wall_damper", "wall_axial_friction", "wall_friction_torque")
+
+    def __init__(self, flat, loads: np.ndarray | None, size: int):
+        self._flat, self._loads, self._size, self._projected = flat, loads, size, None
+
+    def _laws(self) -> dict[str, np.ndarray]:
+        if self._projected is None:
+            if self._loads is None:
+                self._projected = dict.fromkeys(self.NAMES, np.zeros(self._size))
+            else:
+                projected = np.asarray(self._flat.T @ self._loads.reshape(-1, len(self.NAMES)))
+                self._projected = {name: projected[:, k] for k, name in enumerate(self.NAMES)}
+        return self._projected
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self._laws()[name]
+
+    def __iter__(self):
+        return iter(self.NAMES)
+
+    def __len__(self) -> int:
+        return len(self.NAMES)
+
+
 @dataclass
 class WallForces(ForceEvaluation):
     """Nodal state and forces of one evaluation (arrays over the vertices).
@@ -129,6 +159,9 @@ class WallContact:
             self.flat = sp.vstack(by_field, format="csr")[order]
         else:
             self.flat = np.ascontiguousarray(np.vstack(by_field)[order])
+        # the rows of (v, w) alone, interleaved the same way: who touches the wall is known from these
+        lateral = (len(FIELDS) * np.arange(n)[:, None] + np.array([1, 2])).ravel()
+        self.lateral_rows = self.flat[lateral] if space.sparse else np.ascontiguousarray(self.flat[lateral])
 
     @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "WallContact":
@@ -145,81 +178,68 @@ class WallContact:
     def record(self, forces: "WallForces") -> dict[str, float]:
         return {"vertices_in_contact": int(forces.in_contact.sum())}
 
-    def vertex_values(self, q: np.ndarray) -> np.ndarray:
-        """(u, v, w, theta_x) at every vertex: (n_vertices, 4)."""
-        return (self.flat @ q).reshape(-1, len(FIELDS))
-
-    def lateral(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """v and w at every vertex."""
-        values = self.vertex_values(q)
-        return values[:, 1], values[:, 2]
-
     def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> WallForces:
-        values = self.vertex_values(q)
-        v, w = values[:, 1], values[:, 2]
-        delta = indentation(v, w, self.gap)
-        active = np.flatnonzero(delta > 0)
+        """The wall force at (q, qd).  The rows of (v, w) find the vertices in contact; the law and its
+        projection touch those only, and the law-by-law split is projected only when read."""
+        lateral = (self.lateral_rows @ q).reshape(-1, 2)
+        delta = indentation(lateral[:, 0], lateral[:, 1], self.gap)
+        in_contact = delta > 0
+        active = np.flatnonzero(in_contact)
         if active.size == 0:
-            zero, empty = np.zeros_like(q), np.zeros(0)
-            laws = dict.fromkeys(("wall_damper", "wall_axial_friction", "wall_friction_torque"), zero)
-            return WallForces(zero, 0.0, laws, delta, delta > 0, empty, empty, empty, {} if with_tangent else None)
-        rates = self.vertex_values(qd)[active]
-        du, dv, dw, dtx = rates.T
-        va, wa = v[active], w[active]
-        radius = np.hypot(va, wa)
+            empty = np.zeros(0)
+            return WallForces(np.zeros_like(q), 0.0, ProjectedLaws(self.flat, None, q.size), delta, in_contact,
+                              empty, empty, empty, {} if with_tangent else None)
+        du, dv, dw, dtx = (self.flat @ qd).reshape(-1, len(FIELDS))[active].T
+        va, wa = lateral[active, 0], lateral[active, 1]
+        radius = delta[active] + self.gap
         n_v, n_w = va / radius, wa / radius
         d = delta[active]
         d_rate = n_v * dv + n_w * dw
         normal = hunt_crossley_normal_force(d, d_rate, self.k1, self.k2, self.c, self.damper_law)
         axial, torque = wall_friction(normal, du, dtx, self.mu_axial, self.borehole_radius, self.v_s, self.mu_torque)
-        elastic = -self.k1 * d - self.k2 * d**3
-        damper = normal - elastic  # the Hunt-Crossley damper, with the clip that keeps the wall from pulling
-        # nodal loads (F_a, F_v, F_w, T) of the total force and of each non-conservative law, projected at once
-        loads = np.zeros((len(delta), len(FIELDS), 4))
-        loads[active, 0, 0] = axial
-        loads[active, 1, 0], loads[active, 2, 0] = normal * n_v, normal * n_w
-        loads[active, 3, 0] = torque
-        loads[active, 1, 1], loads[active, 2, 1] = damper * n_v, damper * n_w
-        loads[active, 0, 2] = axial
-        loads[active, 3, 3] = torque
-        projected = np.asarray(self.flat.T @ loads.reshape(-1, 4))
-        laws = {"wall_damper": projected[:, 1], "wall_axial_friction": projected[:, 2],
-                "wall_friction_torque": projected[:, 3]}
+        nodal = np.zeros((len(delta), len(FIELDS)))  # (F_a, F_v, F_w, T) at every vertex
+        nodal[active] = np.column_stack([axial, normal * n_v, normal * n_w, torque])
+        # nodal loads of each non-conservative law: the damper (the clip that keeps the wall from pulling
+        # included), the axial friction and the friction torque
+        damper = normal + self.k1 * d + self.k2 * d**3
+        laws = np.zeros((len(delta), len(FIELDS), len(ProjectedLaws.NAMES)))
+        laws[active, 1, 0], laws[active, 2, 0] = damper * n_v, damper * n_w
+        laws[active, 0, 1] = axial
+        laws[active, 3, 2] = torque
         potential = float(np.sum(0.5 * self.k1 * d**2 + 0.25 * self.k2 * d**4))
-        out = WallForces(projected[:, 0], potential, laws, delta, delta > 0, normal, axial, torque)
+        out = WallForces(np.asarray(self.flat.T @ nodal.ravel()), potential, ProjectedLaws(self.flat, laws, q.size),
+                         delta, in_contact, normal, axial, torque)
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
             out.derivatives = {"at": (active, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal)}
         return out
 
-    def _derivatives(self, active, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal) -> dict:
-        """Pointwise derivatives of (F_a, F_v, F_w, T) w.r.t. vertex displacements and velocities."""
+    def _blocks(self, active, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal,
+                c_u: float, c_v: float) -> np.ndarray:
+        """c_u d(F_a, F_v, F_w, T)/d(u, v, w, theta_x) + c_v d(...)/d(velocities) at every vertex in
+        contact: one 4 x 4 block per vertex, rows and columns in the order of FIELDS."""
         pushing = normal < 0  # where the clip of (17) is active the force and its derivatives vanish
         _, damper_by_delta, damper_by_rate = hunt_crossley_damper(d, d_rate, self.c, self.damper_law)
         spring = np.where(pushing, -self.k1 - 3 * self.k2 * d**2 + damper_by_delta, 0.0)
         damper = np.where(pushing, damper_by_rate, 0.0)
-        # d delta / d(v, w) = n ; d delta_rate / d(v, w) = (v_dot - delta_rate n) / r
-        dFn_dv = spring * n_v + damper * (dv - d_rate * n_v) / radius
-        dFn_dw = spring * n_w + damper * (dw - d_rate * n_w) / radius
-        dFn_ddv, dFn_ddw = damper * n_v, damper * n_w
+        # F_n as a function of (v, w, v_dot, w_dot): d delta / d(v, w) = n, d delta_rate / d(v, w) =
+        # (v_dot - delta_rate n) / r, d delta_rate / d(v_dot, w_dot) = n; combined with c_u and c_v
+        dFn_v = c_u * (spring * n_v + damper * (dv - d_rate * n_v) / radius) + c_v * damper * n_v
+        dFn_w = c_u * (spring * n_w + damper * (dw - d_rate * n_w) / radius) + c_v * damper * n_w
         R, mu_a, mu_t = self.borehole_radius, self.mu_axial, self.mu_torque
         s_a = regularised_sign(du, self.v_s)
         s_t = regularised_sign(R * dtx, self.v_s)
-        # F_a = mu F_n s_a and T = mu R F_n s_t since |F_n| = -F_n
-        fa, ft = mu_a * s_a, mu_t * R * s_t
-        curv = normal / radius
-        U, V, W, TX = U_FIELD, V_FIELD, W_FIELD, TX_FIELD
-        position = {  # (output field, input field): d F_out / d y_in
-            (V, V): dFn_dv * n_v + curv * n_w**2, (V, W): dFn_dw * n_v - curv * n_v * n_w,
-            (W, V): dFn_dv * n_w - curv * n_v * n_w, (W, W): dFn_dw * n_w + curv * n_v**2,
-            (U, V): fa * dFn_dv, (U, W): fa * dFn_dw, (TX, V): ft * dFn_dv, (TX, W): ft * dFn_dw,
-        }
-        velocity = {
-            (V, V): dFn_ddv * n_v, (V, W): dFn_ddw * n_v, (W, V): dFn_ddv * n_w, (W, W): dFn_ddw * n_w,
-            (U, V): fa * dFn_ddv, (U, W): fa * dFn_ddw, (TX, V): ft * dFn_ddv, (TX, W): ft * dFn_ddw,
-            (U, U): mu_a * normal * (1 - s_a**2) / self.v_s,
-            (TX, TX): mu_t * R * normal * (1 - s_t**2) * R / self.v_s,
-        }
-        return {"active": active, "position": position, "velocity": velocity}
+        fa, ft = mu_a * s_a, mu_t * R * s_t  # F_a = fa F_n and T = ft F_n, since |F_n| = -F_n
+        curv = c_u * normal / radius  # the turn of the normal n = (v, w) / r with the position
+        blocks = np.zeros((active.size, len(FIELDS), len(FIELDS)))
+        blocks[:, 1, 1] = dFn_v * n_v + curv * n_w**2
+        blocks[:, 1, 2] = dFn_w * n_v - curv * n_v * n_w
+        blocks[:, 2, 1] = dFn_v * n_w - curv * n_v * n_w
+        blocks[:, 2, 2] = dFn_w * n_w + curv * n_v**2
+        blocks[:, 0, 1], blocks[:, 0, 2] = fa * dFn_v, fa * dFn_w
+        blocks[:, 3, 1], blocks[:, 3, 2] = ft * dFn_v, ft * dFn_w
+        blocks[:, 0, 0] = c_v * mu_a * normal * (1 - s_a**2) / self.v_s
+        blocks[:, 3, 3] = c_v * mu_t * R * normal * (1 - s_t**2) * R / self.v_s
+        return blocks
 
     def tangent(self, forces: WallForces, c_u: float, c_v: float):
         """c_u d f/dq + c_v d f/dqd of the generalised wall force (None without contact):
@@ -227,13 +247,8 @@ class WallContact:
         vertex i and A_i the 4 x 4 block of the pointwise derivatives."""
         if not forces.derivatives:
             return None
-        pointwise = self._derivatives(*forces.derivatives["at"])
-        active = pointwise["active"]
-        index = {f: k for k, f in enumerate(FIELDS)}
-        weights = np.zeros((active.size, len(FIELDS), len(FIELDS)))
-        for scale, derivatives in ((c_u, pointwise["position"]), (c_v, pointwise["velocity"])):
-            for (out, inp), w in derivatives.items():
-                weights[:, index[out], index[inp]] += scale * w
+        active = forces.derivatives["at"][0]
+        weights = self._blocks(*forces.derivatives["at"], c_u, c_v)
         rows = (len(FIELDS) * active[:, None] + np.arange(len(FIELDS))).ravel()
         block = self.flat[rows]
         if sp.issparse(block):
