@@ -95,8 +95,9 @@ class AssembledInternalForce:
             weight = fem.Function(fem.functionspace(disc.mesh, ("DG", 0)))
             weight.x.array[cells] = sample.weights
             self.weight = weight
-            self.dofs = np.unique(disc.V.dofmap.list[cells]).astype(PETSc.IntType)  # the dofs the sampled cells touch
+            self.dofs = np.unique(disc.V.dofmap.list[cells]).astype(PETSc.IntType)
             self.phi_rows = space.phi[self.dofs]
+            self._sampled_dofs = PETSc.IS().createGeneral(self.dofs)  # the sampled cells touch these dofs only
 
         def forces(geometric, inertial):
             return (energies.inertial_force(p, psi, self.U, self.V, self.A, dx, inertial, angular_velocity, weight)
@@ -162,8 +163,8 @@ class AssembledInternalForce:
         self._matrix.assemble()
         if self.dofs is None:
             return self.space.project_matrix(petsc_to_scipy(self._matrix))
-        block = self._matrix.getValues(self.dofs, self.dofs)  # the sampled cells touch these dofs only
-        return self.phi_rows.T @ block @ self.phi_rows + sum(c * m for c, m in zip((c_u, c_v, c_a), self.linear)
+        block = petsc_to_scipy(self._matrix.createSubMatrix(self._sampled_dofs, self._sampled_dofs))
+        return self.phi_rows.T @ (block @ self.phi_rows) + sum(c * m for c, m in zip((c_u, c_v, c_a), self.linear)
                                                               if c != 0)
 
     def tangent_parts(self, needed=(True, True, True)):
