@@ -22,6 +22,9 @@ for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 
 import dolfinx_solver  # noqa: F401, E402  (must precede dolfinx / petsc4py)
+# h5py must be loaded before dolfinx.fem.petsc, whose HDF5 1.14 would otherwise be the one h5py finds
+# ("Not a datatype" at import): a notebook may import any module of the package first.
+import h5py  # noqa: F401, E402
 
 from fenics_drill.scene import Scene, SceneError, load_scene  # noqa: E402
 

@@ -45,3 +45,18 @@ def test_run_returns_its_summary_and_its_time_series_as_xarray(tmp_path):
     travel = float(series["bit_displacement"][-1] - series["bit_displacement"][0])
     assert travel / float(series["time"][-1]) == pytest.approx(run.summary["mean_bit_velocity"], rel=1e-12)
     assert np.isclose(run.summary["mean_bit_velocity"], scene.drive.axial_velocity, rtol=0.05)
+
+
+@pytest.mark.parametrize("first", ["fenics_drill.studies.prepare", "fenics_drill.model.internal_force"])
+def test_any_module_imported_first_leaves_h5py_able_to_write(first, tmp_path):
+    """A notebook may import any module first.  dolfinx.fem.petsc loads its own HDF5; h5py imported after
+    it failed at import ("Not a datatype") until the package loaded h5py first.  A fresh interpreter
+    (the import order is per process) writes and reads back a dataset; 300 s bounds a hung import."""
+    import subprocess
+    import sys
+
+    script = (f"import {first}\nimport h5py\nwith h5py.File({str(tmp_path / 'x.h5')!r}, 'w') as f: f['a'] = [1.5]\n"
+              f"print(h5py.File({str(tmp_path / 'x.h5')!r})['a'][0])")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert float(done.stdout.split()[-1]) == 1.5

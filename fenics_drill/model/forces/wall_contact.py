@@ -17,6 +17,7 @@ from typing import ClassVar
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 
 from fenics_drill.model.discretization import THETA_X as TX_FIELD
 from fenics_drill.model.discretization import U as U_FIELD
@@ -29,9 +30,30 @@ from fenics_drill.scene import LAW_SIGN
 FIELDS = (U_FIELD, V_FIELD, W_FIELD, TX_FIELD)  # the fields the wall acts on: F_a, F_v, F_w, T_FS
 
 
-def indentation(v, w, gap):
-    """delta_FS = r - gap, r = sqrt(v^2 + w^2), Eq. (16); positive in contact."""
-    return np.hypot(v, w) - gap
+@njit(cache=True)
+def _damper(delta, delta_rate, damping, printed):
+    """The damper of (17) at one vertex and its derivatives (F_d, dF_d/d delta, dF_d/d delta_dot)."""
+    if printed:
+        cubed = abs(delta_rate) ** 3
+        return -damping * cubed * delta_rate, 0.0, -4.0 * damping * cubed
+    cubed = abs(delta) ** 3
+    return -damping * cubed * delta_rate, -3.0 * damping * delta * delta * delta_rate, -damping * cubed
+
+
+@njit(cache=True)
+def _normal_force(delta, delta_rate, stiffness_linear, stiffness_cubic, damping, printed):
+    """Radial force (17) at one vertex: zero out of contact, and clipped at zero."""
+    if delta <= 0.0:
+        return 0.0
+    force = (-stiffness_linear * delta - stiffness_cubic * delta**3
+             + _damper(delta, delta_rate, damping, printed)[0])
+    return min(force, 0.0)
+
+
+@njit(cache=True)
+def _regularised_sign(x, velocity_scale):
+    """tanh(x / velocity_scale): Coulomb's sgn, smoothed so Newton can converge."""
+    return np.tanh(x / velocity_scale)
 
 
 def hunt_crossley_damper(delta, delta_rate, damping, law="consistent"):
@@ -40,12 +62,7 @@ def hunt_crossley_damper(delta, delta_rate, damping, law="consistent"):
     'consistent': -c |delta|^3 delta_dot, Hunt and Crossley's damper, a force with c in N s/m^4;
     'printed': -c |delta_dot|^3 delta_dot as printed, which has no force's unit (docs/errata.md) and
     grows with the impact speed instead of the indentation.  Both dissipate."""
-    delta, delta_rate = np.asarray(delta, dtype=float), np.asarray(delta_rate, dtype=float)
-    if law == "printed":
-        cubed = np.abs(delta_rate) ** 3
-        return -damping * cubed * delta_rate, np.zeros_like(delta), -4.0 * damping * cubed
-    cubed = np.abs(delta) ** 3
-    return -damping * cubed * delta_rate, -3.0 * damping * delta**2 * delta_rate, -damping * cubed
+    return _DAMPER(delta, delta_rate, damping, law == "printed")
 
 
 def hunt_crossley_normal_force(delta, delta_rate, stiffness_linear, stiffness_cubic, damping, law="consistent"):
@@ -54,16 +71,20 @@ def hunt_crossley_normal_force(delta, delta_rate, stiffness_linear, stiffness_cu
 
     Zero out of contact, and clipped at zero so the damper never makes the wall pull.
     """
-    delta = np.asarray(delta, dtype=float)
-    in_contact = delta > 0
-    d = np.where(in_contact, delta, 0.0)
-    force = -stiffness_linear * d - stiffness_cubic * d**3 + hunt_crossley_damper(d, delta_rate, damping, law)[0]
-    return np.where(in_contact, np.minimum(force, 0.0), 0.0)
+    return _NORMAL_FORCE(delta, delta_rate, stiffness_linear, stiffness_cubic, damping, law == "printed")
 
 
-def regularised_sign(x, velocity_scale):
-    """tanh(x / velocity_scale): Coulomb's sgn, smoothed so Newton can converge."""
-    return np.tanh(np.asarray(x, dtype=float) / velocity_scale)
+_DAMPER = np.vectorize(_damper, otypes=(float, float, float))
+_NORMAL_FORCE = np.vectorize(_normal_force, otypes=(float,))
+
+
+@njit(cache=True)
+def _friction(normal_force, axial_velocity, spin_rate, friction, torque_friction, borehole_radius, velocity_scale):
+    """(18) and (19) at one vertex: -mu |F_n| sgn(u_dot) and -mu_T |F_n| R_bh sgn(R_bh theta_x_dot)."""
+    magnitude = abs(normal_force)
+    return (-friction * magnitude * _regularised_sign(axial_velocity, velocity_scale),
+            -torque_friction * magnitude * borehole_radius
+            * _regularised_sign(borehole_radius * spin_rate, velocity_scale))
 
 
 def wall_friction(normal_force, axial_velocity, spin_rate, friction, borehole_radius, velocity_scale,
@@ -71,14 +92,103 @@ def wall_friction(normal_force, axial_velocity, spin_rate, friction, borehole_ra
     """Axial friction force (18) and friction torque (19) with the magnitude |F_n|:
     F_a = -mu |F_n| sgn(u_dot), T = -mu_T |F_n| R_bh sgn(theta_x_dot) (mu_T = ``torque_friction``, mu if None).
 
-    Both signs are regularised on a sliding speed: u_dot and R_bh theta_x_dot.  As printed, (18) and
-    (19) read -mu F_n sgn with F_n <= 0: the same laws with mu -> -mu, which push along the motion."""
+    Both signs are tanh(x / velocity_scale): Coulomb's sgn, regularised on a sliding speed (u_dot and
+    R_bh theta_x_dot) so Newton can converge.  As printed, (18) and (19) read -mu F_n sgn with F_n <= 0:
+    the same laws with mu -> -mu, which push along the motion."""
     torque_friction = friction if torque_friction is None else torque_friction
-    magnitude = np.abs(normal_force)
-    force = -friction * magnitude * regularised_sign(axial_velocity, velocity_scale)
-    torque = -torque_friction * magnitude * borehole_radius * regularised_sign(
-        borehole_radius * np.asarray(spin_rate), velocity_scale)
-    return force, torque
+    return _FRICTION(normal_force, axial_velocity, spin_rate, friction, torque_friction, borehole_radius,
+                     velocity_scale)
+
+
+_FRICTION = np.vectorize(_friction, otypes=(float, float))
+
+
+@njit(cache=True)
+def _vertex_loads(lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s):
+    """Eqs. (16)-(19) at every vertex: indentation, nodal loads (F_a, F_v, F_w, T), the loads of the
+    damper, the axial friction and the friction torque (vertex, field, law), and the springs' energy."""
+    n = lateral.shape[0]
+    delta = np.empty(n)
+    nodal = np.zeros((n, 4))
+    laws = np.zeros((n, 4, 3))
+    potential = 0.0
+    for i in range(n):
+        v, w = lateral[i, 0], lateral[i, 1]
+        r = np.hypot(v, w)
+        d = r - gap
+        delta[i] = d
+        if d <= 0.0:
+            continue
+        n_v, n_w = v / r, w / r
+        normal = _normal_force(d, n_v * rates[i, 1] + n_w * rates[i, 2], k1, k2, damping, printed)
+        axial, torque = _friction(normal, rates[i, 0], rates[i, 3], mu_axial, mu_torque, radius_bh, v_s)
+        nodal[i, 0], nodal[i, 1], nodal[i, 2], nodal[i, 3] = axial, normal * n_v, normal * n_w, torque
+        damper = normal + k1 * d + k2 * d**3  # with the clip that keeps the wall from pulling
+        laws[i, 1, 0], laws[i, 2, 0] = damper * n_v, damper * n_w
+        laws[i, 0, 1] = axial
+        laws[i, 3, 2] = torque
+        potential += 0.5 * k1 * d**2 + 0.25 * k2 * d**4
+    return delta, nodal, laws, potential
+
+
+@njit(cache=True)
+def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s,
+                    c_u, c_v):
+    """c_u d(F_a, F_v, F_w, T)/d(u, v, w, theta_x) + c_v d(...)/d(velocities) at every vertex in contact:
+    one 4 x 4 block per vertex, rows and columns in the order of FIELDS."""
+    blocks = np.zeros((active.size, 4, 4))
+    for k in range(active.size):
+        i = active[k]
+        v, w = lateral[i, 0], lateral[i, 1]
+        r = np.hypot(v, w)
+        d = r - gap
+        n_v, n_w = v / r, w / r
+        dv, dw = rates[i, 1], rates[i, 2]
+        d_rate = n_v * dv + n_w * dw
+        normal = _normal_force(d, d_rate, k1, k2, damping, printed)
+        if normal >= 0.0:  # where the clip of (17) is active the force and its derivatives vanish
+            continue
+        _, damper_by_delta, damper_by_rate = _damper(d, d_rate, damping, printed)
+        spring = -k1 - 3.0 * k2 * d * d + damper_by_delta
+        # F_n of (v, w, v_dot, w_dot): d delta / d(v, w) = n, d delta_rate / d(v, w) = (v_dot - delta_rate n) / r,
+        # d delta_rate / d(v_dot, w_dot) = n
+        dfn_v = c_u * (spring * n_v + damper_by_rate * (dv - d_rate * n_v) / r) + c_v * damper_by_rate * n_v
+        dfn_w = c_u * (spring * n_w + damper_by_rate * (dw - d_rate * n_w) / r) + c_v * damper_by_rate * n_w
+        s_a = _regularised_sign(rates[i, 0], v_s)
+        s_t = _regularised_sign(radius_bh * rates[i, 3], v_s)
+        fa, ft = mu_axial * s_a, mu_torque * radius_bh * s_t  # F_a = fa F_n, T = ft F_n
+        curv = c_u * normal / r  # the turn of the normal n = (v, w) / r with the position
+        b = blocks[k]
+        b[1, 1] = dfn_v * n_v + curv * n_w * n_w
+        b[1, 2] = dfn_w * n_v - curv * n_v * n_w
+        b[2, 1] = dfn_v * n_w - curv * n_v * n_w
+        b[2, 2] = dfn_w * n_w + curv * n_v * n_v
+        b[0, 1], b[0, 2] = fa * dfn_v, fa * dfn_w
+        b[3, 1], b[3, 2] = ft * dfn_v, ft * dfn_w
+        b[0, 0] = c_v * mu_axial * normal * (1.0 - s_a * s_a) / v_s
+        b[3, 3] = c_v * mu_torque * radius_bh * normal * (1.0 - s_t * s_t) * radius_bh / v_s
+    return blocks
+
+
+@njit(cache=True)
+def _weighted_rows(flat, active, blocks):
+    """R, the rows of (u, v, w, theta_x) of the dense [Phi] at the vertices in contact, and A R for the
+    blocks A of :func:`_contact_blocks`: the wall's tangent is R^T (A R)."""
+    size = flat.shape[1]
+    rows = np.empty((4 * active.size, size))
+    weighted = np.zeros((4 * active.size, size))
+    for k in range(active.size):
+        for f in range(4):
+            source = 4 * active[k] + f
+            for j in range(size):
+                rows[4 * k + f, j] = flat[source, j]
+        for o in range(4):
+            for f in range(4):
+                a = blocks[k, o, f]
+                if a != 0.0:
+                    for j in range(size):
+                        weighted[4 * k + o, j] += a * rows[4 * k + f, j]
+    return rows, weighted
 
 
 class ProjectedLaws(Mapping):
@@ -88,16 +198,13 @@ class ProjectedLaws(Mapping):
 
     NAMES = ("wall_damper", "wall_axial_friction", "wall_friction_torque")
 
-    def __init__(self, flat, loads: np.ndarray | None, size: int):
-        self._flat, self._loads, self._size, self._projected = flat, loads, size, None
+    def __init__(self, flat, loads: np.ndarray):
+        self._flat, self._loads, self._projected = flat, loads, None
 
     def _laws(self) -> dict[str, np.ndarray]:
         if self._projected is None:
-            if self._loads is None:
-                self._projected = dict.fromkeys(self.NAMES, np.zeros(self._size))
-            else:
-                projected = np.asarray(self._flat.T @ self._loads.reshape(-1, len(self.NAMES)))
-                self._projected = {name: projected[:, k] for k, name in enumerate(self.NAMES)}
+            projected = np.asarray(self._flat.T @ self._loads.reshape(-1, len(self.NAMES)))
+            self._projected = {name: projected[:, k] for k, name in enumerate(self.NAMES)}
         return self._projected
 
     def __getitem__(self, name: str) -> np.ndarray:
@@ -178,82 +285,41 @@ class WallContact:
     def record(self, forces: "WallForces") -> dict[str, float]:
         return {"vertices_in_contact": int(forces.in_contact.sum())}
 
+    def _law(self) -> tuple:
+        """The law's constants, in the order the compiled kernels take them."""
+        return (self.gap, self.k1, self.k2, self.c, self.damper_law == "printed", self.mu_axial, self.mu_torque,
+                self.borehole_radius, self.v_s)
+
     def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> WallForces:
-        """The wall force at (q, qd).  The rows of (v, w) find the vertices in contact; the law and its
-        projection touch those only, and the law-by-law split is projected only when read."""
+        """The wall force at (q, qd).  The rows of (v, w) find the vertices in contact, the law runs
+        compiled over the vertices, and the law-by-law split is projected only when read."""
         lateral = (self.lateral_rows @ q).reshape(-1, 2)
-        delta = indentation(lateral[:, 0], lateral[:, 1], self.gap)
+        rates = (self.flat @ qd).reshape(-1, len(FIELDS))
+        delta, nodal, laws, potential = _vertex_loads(lateral, rates, *self._law())
         in_contact = delta > 0
         active = np.flatnonzero(in_contact)
-        if active.size == 0:
-            empty = np.zeros(0)
-            return WallForces(np.zeros_like(q), 0.0, ProjectedLaws(self.flat, None, q.size), delta, in_contact,
-                              empty, empty, empty, {} if with_tangent else None)
-        du, dv, dw, dtx = (self.flat @ qd).reshape(-1, len(FIELDS))[active].T
-        va, wa = lateral[active, 0], lateral[active, 1]
-        radius = delta[active] + self.gap
-        n_v, n_w = va / radius, wa / radius
-        d = delta[active]
-        d_rate = n_v * dv + n_w * dw
-        normal = hunt_crossley_normal_force(d, d_rate, self.k1, self.k2, self.c, self.damper_law)
-        axial, torque = wall_friction(normal, du, dtx, self.mu_axial, self.borehole_radius, self.v_s, self.mu_torque)
-        nodal = np.zeros((len(delta), len(FIELDS)))  # (F_a, F_v, F_w, T) at every vertex
-        nodal[active] = np.column_stack([axial, normal * n_v, normal * n_w, torque])
-        # nodal loads of each non-conservative law: the damper (the clip that keeps the wall from pulling
-        # included), the axial friction and the friction torque
-        damper = normal + self.k1 * d + self.k2 * d**3
-        laws = np.zeros((len(delta), len(FIELDS), len(ProjectedLaws.NAMES)))
-        laws[active, 1, 0], laws[active, 2, 0] = damper * n_v, damper * n_w
-        laws[active, 0, 1] = axial
-        laws[active, 3, 2] = torque
-        potential = float(np.sum(0.5 * self.k1 * d**2 + 0.25 * self.k2 * d**4))
-        out = WallForces(np.asarray(self.flat.T @ nodal.ravel()), potential, ProjectedLaws(self.flat, laws, q.size),
-                         delta, in_contact, normal, axial, torque)
+        out = WallForces(np.asarray(self.flat.T @ nodal.ravel()), potential, ProjectedLaws(self.flat, laws),
+                         delta, in_contact, *(-np.hypot(nodal[active, 1], nodal[active, 2]), nodal[active, 0],
+                                             nodal[active, 3]))
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
-            out.derivatives = {"at": (active, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal)}
+            out.derivatives = {"at": (active, lateral, rates)}
         return out
-
-    def _blocks(self, active, n_v, n_w, radius, d, d_rate, dv, dw, du, dtx, normal,
-                c_u: float, c_v: float) -> np.ndarray:
-        """c_u d(F_a, F_v, F_w, T)/d(u, v, w, theta_x) + c_v d(...)/d(velocities) at every vertex in
-        contact: one 4 x 4 block per vertex, rows and columns in the order of FIELDS."""
-        pushing = normal < 0  # where the clip of (17) is active the force and its derivatives vanish
-        _, damper_by_delta, damper_by_rate = hunt_crossley_damper(d, d_rate, self.c, self.damper_law)
-        spring = np.where(pushing, -self.k1 - 3 * self.k2 * d**2 + damper_by_delta, 0.0)
-        damper = np.where(pushing, damper_by_rate, 0.0)
-        # F_n as a function of (v, w, v_dot, w_dot): d delta / d(v, w) = n, d delta_rate / d(v, w) =
-        # (v_dot - delta_rate n) / r, d delta_rate / d(v_dot, w_dot) = n; combined with c_u and c_v
-        dFn_v = c_u * (spring * n_v + damper * (dv - d_rate * n_v) / radius) + c_v * damper * n_v
-        dFn_w = c_u * (spring * n_w + damper * (dw - d_rate * n_w) / radius) + c_v * damper * n_w
-        R, mu_a, mu_t = self.borehole_radius, self.mu_axial, self.mu_torque
-        s_a = regularised_sign(du, self.v_s)
-        s_t = regularised_sign(R * dtx, self.v_s)
-        fa, ft = mu_a * s_a, mu_t * R * s_t  # F_a = fa F_n and T = ft F_n, since |F_n| = -F_n
-        curv = c_u * normal / radius  # the turn of the normal n = (v, w) / r with the position
-        blocks = np.zeros((active.size, len(FIELDS), len(FIELDS)))
-        blocks[:, 1, 1] = dFn_v * n_v + curv * n_w**2
-        blocks[:, 1, 2] = dFn_w * n_v - curv * n_v * n_w
-        blocks[:, 2, 1] = dFn_v * n_w - curv * n_v * n_w
-        blocks[:, 2, 2] = dFn_w * n_w + curv * n_v**2
-        blocks[:, 0, 1], blocks[:, 0, 2] = fa * dFn_v, fa * dFn_w
-        blocks[:, 3, 1], blocks[:, 3, 2] = ft * dFn_v, ft * dFn_w
-        blocks[:, 0, 0] = c_v * mu_a * normal * (1 - s_a**2) / self.v_s
-        blocks[:, 3, 3] = c_v * mu_t * R * normal * (1 - s_t**2) * R / self.v_s
-        return blocks
 
     def tangent(self, forces: WallForces, c_u: float, c_v: float):
         """c_u d f/dq + c_v d f/dqd of the generalised wall force (None without contact):
         sum over the vertices in contact of R_i^T A_i R_i, with R_i the four rows of [Phi] of
         vertex i and A_i the 4 x 4 block of the pointwise derivatives."""
-        if not forces.derivatives:
+        if forces.derivatives is None:
             return None
-        active = forces.derivatives["at"][0]
-        weights = self._blocks(*forces.derivatives["at"], c_u, c_v)
-        rows = (len(FIELDS) * active[:, None] + np.arange(len(FIELDS))).ravel()
-        block = self.flat[rows]
-        if sp.issparse(block):
-            diagonal = sp.bsr_matrix((weights, np.arange(active.size), np.arange(active.size + 1)),
+        active, lateral, rates = forces.derivatives["at"]
+        if active.size == 0:
+            return None
+        blocks = _contact_blocks(active, lateral, rates, *self._law(), c_u, c_v)
+        if sp.issparse(self.flat):
+            rows = (len(FIELDS) * active[:, None] + np.arange(len(FIELDS))).ravel()
+            block = self.flat[rows]
+            diagonal = sp.bsr_matrix((blocks, np.arange(active.size), np.arange(active.size + 1)),
                                      shape=(rows.size, rows.size))
             return sp.csr_matrix(block.T @ (diagonal @ block))
-        size = block.shape[1]
-        return block.T @ np.matmul(weights, block.reshape(active.size, len(FIELDS), size)).reshape(rows.size, size)
+        rows, weighted = _weighted_rows(self.flat, active, blocks)
+        return rows.T @ weighted
