@@ -17,6 +17,7 @@ import argparse
 import json
 import os
 import platform
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -94,6 +95,8 @@ def main() -> None:
     before_tree = runs / "before-tree"
     if not before_tree.exists():
         subprocess.run(["git", "worktree", "add", "--detach", str(before_tree), args.before], cwd=ROOT, check=True)
+    if not (before_tree / "fenics_drill/forms").exists():  # the weak forms ship as fenics_drill.forms (pyproject)
+        shutil.copytree(before_tree / "forms", before_tree / "fenics_drill/forms")
     trees = {f"before ({args.before})": before_tree, "after": ROOT}
     lines = [f"# Speed before and after issue 17 ({platform.processor() or platform.machine()}, "
              f"{os.cpu_count()} cores, one per run)", "",
