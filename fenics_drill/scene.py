@@ -109,6 +109,8 @@ class Contact:
     sliding_velocity_scale: float = _pos(
         "v_s of the regularised sgn(v) = tanh(v / v_s) in (18)-(19), applied to the axial velocity "
         "and to the surface speed R_bh theta_x_dot [m/s]", 1e-3)
+    culling: bool = key(True, "evaluate the wall law only at the vertices that can reach the wall (exact: a bound "
+                        "on the motion since the last check proves the others cannot); false: at every vertex")
 
 
 @dataclass(frozen=True)

@@ -233,6 +233,19 @@ class WallForces(ForceEvaluation):
     derivatives: dict | None = None
 
 
+@dataclass(frozen=True)
+class VertexSet:
+    """Vertices the wall law is evaluated at, with their rows of [Phi]: all of them, or those that can
+    reach the wall while q stays near ``q_ref`` (:meth:`WallContact._near_vertices`)."""
+
+    vertices: np.ndarray
+    lateral_rows: object  # (v, w) of each vertex, interleaved
+    flat: object  # (u, v, w, theta_x) of each vertex, interleaved
+    q_ref: np.ndarray | None = None
+    column_bound: np.ndarray | None = None
+    reach: float = np.inf
+
+
 class WallContact:
     """Impact and friction forces of the borehole wall on the vertices of the mesh."""
 
@@ -244,9 +257,10 @@ class WallContact:
     }
 
     def __init__(self, disc: BeamDiscretization, space, contact, borehole_radius: float,
-                 law_sign: tuple[float, float] = (1.0, 1.0), damper_law: str = "consistent"):
+                 law_sign: tuple[float, float] = (1.0, 1.0), damper_law: str = "consistent", culling: bool = True):
         """``contact``: the scene's [contact] section; ``law_sign``: +1 (consistent) or -1 (as printed) for
-        the axial friction (18) and the friction torque (19); ``damper_law``: the damper of (17)."""
+        the axial friction (18) and the friction torque (19); ``damper_law``: the damper of (17);
+        ``culling``: evaluate the law only at the vertices that can reach the wall (exact)."""
         self.x = disc.vertex_x
         self.gap = borehole_radius - disc.properties.outer_radius
         self.borehole_radius = borehole_radius
@@ -268,13 +282,19 @@ class WallContact:
             self.flat = np.ascontiguousarray(np.vstack(by_field)[order])
         # the rows of (v, w) alone, interleaved the same way: who touches the wall is known from these
         lateral = (len(FIELDS) * np.arange(n)[:, None] + np.array([1, 2])).ravel()
-        self.lateral_rows = self.flat[lateral] if space.sparse else np.ascontiguousarray(self.flat[lateral])
+        lateral_rows = self.flat[lateral] if space.sparse else np.ascontiguousarray(self.flat[lateral])
+        self.every = VertexSet(np.arange(n), lateral_rows, self.flat)
+        # |P_i[:, j]|_1 of each vertex's (v, w) rows P_i: |(v, w)_i(q) - (v, w)_i(q_ref)| <= sum_j of it |dq_j|
+        self._column_sizes = abs(lateral_rows[0::2]) + abs(lateral_rows[1::2])
+        self.culling = culling
+        self._near = None  # the VertexSet of the last culled evaluation
 
     @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "WallContact":
         signs = (LAW_SIGN[scene.law(scene.contact.axial_friction_law)],
                  LAW_SIGN[scene.law(scene.contact.friction_torque_law)])
-        return cls(disc, space, scene.contact, scene.borehole.radius, signs, scene.law(scene.contact.damper_law))
+        return cls(disc, space, scene.contact, scene.borehole.radius, signs, scene.law(scene.contact.damper_law),
+                   scene.contact.culling)
 
     def with_stiffness_scale(self, factor: float) -> "WallContact":
         """A copy whose wall springs k_FS1, k_FS2 are scaled by ``factor`` (the static continuation)."""
@@ -290,19 +310,48 @@ class WallContact:
         return (self.gap, self.k1, self.k2, self.c, self.damper_law == "printed", self.mu_axial, self.mu_torque,
                 self.borehole_radius, self.v_s)
 
+    #: Vertices within this share of the gap from the wall are evaluated; the others are left out until
+    #: q has moved enough, by the bound of :meth:`_near_vertices`, to possibly bring one of them to it.
+    NEAR = 0.5
+
+    def _near_vertices(self, q: np.ndarray) -> VertexSet:
+        """The vertices that can touch the wall at q, exactly.  At a reference state q_ref the radius of
+        every vertex is computed; those farther than NEAR gap from the wall are then left out while
+        sum_j c_j |q_j - q_ref_j| < min of their distances to the wall, with c_j the largest
+        |P_i[:, j]|_1 among them: by the triangle inequality none of them can have reached it."""
+        near = self._near
+        if near is not None and near.column_bound @ np.abs(q - near.q_ref) < near.reach:
+            return near
+        radius = np.hypot(*(self.every.lateral_rows @ q).reshape(-1, 2).T)
+        slack = self.gap - radius  # each vertex's distance to the wall
+        far = slack > self.NEAR * self.gap
+        watched = far if far.any() else np.ones_like(far)  # without far vertices: every vertex, until q moves
+        sizes = self._column_sizes[np.flatnonzero(watched)].max(axis=0)
+        column_bound = sizes.toarray().ravel() if sp.issparse(sizes) else np.asarray(sizes).ravel()
+        reach = float(np.min(slack[far])) if far.any() else self.NEAR * self.gap
+        vertices = np.flatnonzero(~far)
+        rows = (len(FIELDS) * vertices[:, None] + np.arange(len(FIELDS))).ravel()
+        lateral = (2 * vertices[:, None] + np.arange(2)).ravel()
+        self._near = VertexSet(vertices, self.every.lateral_rows[lateral], self.flat[rows], q.copy(), column_bound,
+                               reach)
+        return self._near
+
     def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> WallForces:
         """The wall force at (q, qd).  The rows of (v, w) find the vertices in contact, the law runs
-        compiled over the vertices, and the law-by-law split is projected only when read."""
-        lateral = (self.lateral_rows @ q).reshape(-1, 2)
-        rates = (self.flat @ qd).reshape(-1, len(FIELDS))
+        compiled over the vertices that can reach the wall, and the law-by-law split is projected only
+        when read.  The indentation is -inf at the vertices left out."""
+        vertex_set = self._near_vertices(q) if self.culling else self.every
+        lateral = (vertex_set.lateral_rows @ q).reshape(-1, 2)
+        rates = (vertex_set.flat @ qd).reshape(-1, len(FIELDS))
         delta, nodal, laws, potential = _vertex_loads(lateral, rates, *self._law())
-        in_contact = delta > 0
-        active = np.flatnonzero(in_contact)
-        out = WallForces(np.asarray(self.flat.T @ nodal.ravel()), potential, ProjectedLaws(self.flat, laws),
-                         delta, in_contact, *(-np.hypot(nodal[active, 1], nodal[active, 2]), nodal[active, 0],
-                                             nodal[active, 3]))
+        active = np.flatnonzero(delta > 0)
+        indentation = np.full(len(self.x), -np.inf)
+        indentation[vertex_set.vertices] = delta
+        out = WallForces(np.asarray(vertex_set.flat.T @ nodal.ravel()), potential,
+                         ProjectedLaws(vertex_set.flat, laws), indentation, indentation > 0,
+                         -np.hypot(nodal[active, 1], nodal[active, 2]), nodal[active, 0], nodal[active, 3])
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
-            out.derivatives = {"at": (active, lateral, rates)}
+            out.derivatives = {"at": (vertex_set.flat, active, lateral, rates)}
         return out
 
     def tangent(self, forces: WallForces, c_u: float, c_v: float):
@@ -311,15 +360,15 @@ class WallContact:
         vertex i and A_i the 4 x 4 block of the pointwise derivatives."""
         if forces.derivatives is None:
             return None
-        active, lateral, rates = forces.derivatives["at"]
+        flat, active, lateral, rates = forces.derivatives["at"]
         if active.size == 0:
             return None
         blocks = _contact_blocks(active, lateral, rates, *self._law(), c_u, c_v)
-        if sp.issparse(self.flat):
+        if sp.issparse(flat):
             rows = (len(FIELDS) * active[:, None] + np.arange(len(FIELDS))).ravel()
-            block = self.flat[rows]
+            block = flat[rows]
             diagonal = sp.bsr_matrix((blocks, np.arange(active.size), np.arange(active.size + 1)),
                                      shape=(rows.size, rows.size))
             return sp.csr_matrix(block.T @ (diagonal @ block))
-        rows, weighted = _weighted_rows(self.flat, active, blocks)
+        rows, weighted = _weighted_rows(flat, active, blocks)
         return rows.T @ weighted
