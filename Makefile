@@ -43,6 +43,7 @@ test: setup
 ## full order (benchmarks/reduced_accuracy.md, issue 14), then the older studies.
 bench: setup
 	$(PY) benchmarks/speed_table.py --before 50d35ac
+	$(PY) benchmarks/evaluation_costs.py
 	$(PY) benchmarks/reduced_accuracy.py --t-end 2 --runs $(OUT)/accuracy
 	$(PY) benchmarks/modal_timing.py
 	$(PY) benchmarks/dynamics_convergence.py

@@ -19,6 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
+from fenics_drill.model.compiled import kernel
 from fenics_drill.model.discretization import THETA_X as TX_FIELD
 from fenics_drill.model.discretization import U as U_FIELD
 from fenics_drill.model.discretization import V as V_FIELD
@@ -103,7 +104,7 @@ def wall_friction(normal_force, axial_velocity, spin_rate, friction, borehole_ra
 _FRICTION = np.vectorize(_friction, otypes=(float, float))
 
 
-@njit(cache=True)
+@kernel
 def _vertex_loads(lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s):
     """Eqs. (16)-(19) at every vertex: indentation, nodal loads (F_a, F_v, F_w, T), the loads of the
     damper, the axial friction and the friction torque (vertex, field, law), and the springs' energy."""
@@ -131,7 +132,7 @@ def _vertex_loads(lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_to
     return delta, nodal, laws, potential
 
 
-@njit(cache=True)
+@kernel
 def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s,
                     c_u, c_v):
     """c_u d(F_a, F_v, F_w, T)/d(u, v, w, theta_x) + c_v d(...)/d(velocities) at every vertex in contact:
@@ -170,7 +171,7 @@ def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_ax
     return blocks
 
 
-@njit(cache=True)
+@kernel
 def _weighted_rows(flat, active, blocks):
     """R, the rows of (u, v, w, theta_x) of the dense [Phi] at the vertices in contact, and A R for the
     blocks A of :func:`_contact_blocks`: the wall's tangent is R^T (A R)."""

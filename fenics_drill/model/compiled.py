@@ -1,0 +1,43 @@
+"""Compiled kernels of the model (Numba) that Ctrl-C and SIGTERM still stop cleanly.
+
+A run is stopped by a signal handler that raises KeyboardInterrupt
+(:mod:`fenics_drill.studies.lifecycle`).  When the signal arrives while a Numba kernel is being
+called, Numba reports that exception as a SystemError chained to it, and the run would end as
+"failed" instead of "interrupted" (its summary, its exit code 130).  :func:`kernel` compiles a
+function (cached on disk, so a process pays the compilation once per install) and calls it through a
+wrapper that raises the interrupt as what it is.  Kernels called only from other kernels need
+``numba.njit(cache=True)`` alone: the wrapper is for the ones Python calls.
+"""
+
+from __future__ import annotations
+
+import functools
+
+from numba import njit
+
+
+def interrupt_in(error: BaseException) -> KeyboardInterrupt | None:
+    """The KeyboardInterrupt that ``error`` was chained from, if any."""
+    seen = 0
+    while error is not None and seen < 16:
+        if isinstance(error, KeyboardInterrupt):
+            return error
+        error, seen = error.__cause__ or error.__context__, seen + 1
+    return None
+
+
+def kernel(function):
+    """``function`` compiled by Numba (nopython, cached), called so that an interrupt is not a failure."""
+    compiled = njit(cache=True)(function)
+
+    @functools.wraps(function)
+    def call(*args):
+        try:
+            return compiled(*args)
+        except SystemError as error:
+            if interrupt_in(error) is None:
+                raise
+            raise KeyboardInterrupt from error
+
+    call.compiled = compiled
+    return call
