@@ -1,0 +1,75 @@
+"""Where a run's time goes, without a profiler: the time loop's parts timed around their calls.
+
+    python benchmarks/loop_split.py T_END
+
+Runs the paper scene for T_END seconds (no field output) and prints the total, the time loop (the
+ECSW training run included) and, inside it, the Newton steps, the per-step recording (time series,
+von Mises), the energies and power terms of the budget, the step's error estimate and the sample
+checks.  cProfile inflates small calls; this does not (benchmarks/RESULTS.md, issue 17).
+"""
+
+from __future__ import annotations
+
+import collections
+import sys
+import tempfile
+import time
+
+import fenics_drill  # noqa: F401  (dolfinx_solver and h5py first)
+import fenics_drill.solvers.time_loop as time_loop
+from fenics_drill.scene import load_scene
+from fenics_drill.studies.run import run_scene
+
+SPENT: collections.Counter = collections.Counter()
+
+
+def timed(owner, name: str, key: str) -> None:
+    """Replace the method ``owner.name`` by one that adds its wall time to SPENT[key]."""
+    method = getattr(owner, name)
+
+    def wrapper(*args, **kwargs):
+        clock = time.perf_counter()
+        try:
+            return method(*args, **kwargs)
+        finally:
+            SPENT[key] += time.perf_counter() - clock
+
+    setattr(owner, name, wrapper)
+
+
+def main() -> None:
+    timed(time_loop.NewmarkNewton, "step", "Newton steps")
+    timed(time_loop.Simulation, "_power_terms", "power terms of the budget")
+    timed(time_loop.Simulation, "mechanical_energy", "energies of the budget")
+    timed(time_loop.Simulation, "_check_sample", "sample checks")
+    timed(time_loop.EnergyBudget, "advance", "budget advance")
+    timed(time_loop.StepController, "error_ratio", "error estimate")
+    run = time_loop.Simulation.run
+
+    def timed_run(self, state, t_end, on_step=None, progress=None):
+        def recorded(record):
+            clock = time.perf_counter()
+            try:
+                return on_step(record) if on_step is not None else None
+            finally:
+                SPENT["recording (rows, von Mises)"] += time.perf_counter() - clock
+
+        clock = time.perf_counter()
+        try:
+            return run(self, state, t_end, recorded, progress)
+        finally:
+            SPENT["time loop"] += time.perf_counter() - clock
+
+    time_loop.Simulation.run = timed_run
+    scene = load_scene("demos/scenes/paper.toml", [f"time.t_end={sys.argv[1]}", "output.field_interval=0"])
+    with tempfile.TemporaryDirectory() as out:
+        clock = time.perf_counter()
+        summary = run_scene(scene, out, progress=False, overwrite=True)
+        total = time.perf_counter() - clock
+    print(f"total {total:.2f} s, {summary['steps']} steps, {summary['newton_iterations']} Newton iterations")
+    for key, seconds in SPENT.most_common():
+        print(f"  {key:30s} {seconds:7.2f} s")
+
+
+if __name__ == "__main__":
+    main()
