@@ -39,5 +39,4 @@ def kernel(function):
                 raise
             raise KeyboardInterrupt from error
 
-    call.compiled = compiled
     return call
