@@ -150,7 +150,7 @@ class DrillstringModel:
 
     def full_order(self) -> "DrillstringModel":
         """The same string in the full finite-element space (no modal reduction), sharing the operators."""
-        return DrillstringModel(self.scene, self.disc, FullSpace(self.disc.ndofs, self.disc.support_dofs),
+        return DrillstringModel(self.scene, self.disc, FullSpace(self.disc),
                                 self.operators, None, self.modes, {})
 
     def with_vectors(self, vectors: np.ndarray, guard: dict) -> "DrillstringModel":
@@ -227,15 +227,13 @@ class DrillstringModel:
     def _tangent(self, coefficients, internal_parts, evaluations, drive):
         """c_u dr/dq + c_v dr/dqd + c_a dr/dqdd of the residual of :meth:`evaluate`."""
         c_u, c_v, c_a = coefficients
-        J = sum(c * part for c, part in zip(coefficients, internal_parts) if c != 0)
+        terms = [(c, part) for c, part in zip(coefficients, internal_parts) if c != 0]
         inertia = self.drive.inertia_tangent(c_a)
         if inertia is not None:
-            J = J + inertia
+            terms.append((1.0, inertia))
         load_tangents = [force.tangent(evaluations[force.name], c_u, c_v) for force in self.forces]
-        for load_tangent in [*load_tangents, self.drive.tangent(drive, c_u, c_v)]:
-            if load_tangent is not None:
-                J = J - load_tangent
-        return J
+        terms += [(-1.0, t) for t in [*load_tangents, self.drive.tangent(drive, c_u, c_v)] if t is not None]
+        return self.space.combine(terms)
 
     def kinetic_energy(self, q, qd) -> float:
         """Kinetic energy (24) of the string plus that of the top drive."""

@@ -118,17 +118,16 @@ class AssembledInternalForce:
         self._kinetic = fem.form(energy(kinetic, energies.kinetic_energy_density(p, self.U, self.V, False)))
         self._strain = fem.form(energy(strain, energies.strain_energy_density(p, energies.strain_slots(self.U),
                                                                               False)))
-        self.c_u, self.c_v, self.c_a = (fem.Constant(disc.mesh, PETSc.ScalarType(0.0)) for _ in range(3))
-        jacobian = (
-            self.c_u * ufl.derivative(residual, self.U, dU)
-            + self.c_v * ufl.derivative(residual, self.V, dU)
-            + self.c_a * ufl.derivative(residual, self.A, dU)
-        )
         self._residual = fem.form(residual)
-        self._jacobian = fem.form(jacobian)
         self._vector = fem_petsc.create_vector(self._residual.function_spaces)
-        self._matrix = fem_petsc.create_matrix(self._jacobian)
+        # one form per derivative df/dq, df/dqd, df/dqdd (None where f does not depend on it): each part is
+        # assembled by a kernel of its own, not by the whole Jacobian's kernel with two coefficients zero
+        self._jacobians = tuple(_nonzero_form(ufl.derivative(residual, field, dU)) for field in (self.U, self.V, self.A))
+        self._matrices = tuple(fem_petsc.create_matrix(form) if form is not None else None for form in self._jacobians)
         self._damping = space.project_matrix(operators.damping)  # (45) is linear: reused for the budget
+        self._packing = SampledCoefficients(self._residual, (self.U, self.V, self.A), self.dofs, self.phi_rows) \
+            if sample is not None else None
+        self._state = None  # (q, qd, qdd) of the last evaluation, set on the functions when a tangent needs it
 
     def _set(self, function: fem.Function, values: np.ndarray) -> None:
         if self.dofs is None:
@@ -148,30 +147,36 @@ class AssembledInternalForce:
         return self._vector.array
 
     def evaluate(self, q, qd, qdd) -> np.ndarray:
-        vector = self.assembled_vector(q, qd, qdd)
         if self.dofs is None:
-            return self.space.project(vector)
+            return self.space.project(self.assembled_vector(q, qd, qdd))
+        self._state = (q, qd, qdd)
         K, C, M = self.linear
-        return K @ q + C @ qd + M @ qdd + self.phi_rows.T @ vector[self.dofs]
+        return K @ q + C @ qd + M @ qdd + self.phi_rows.T @ self._packing.assemble(q, qd, qdd)
 
     state_dependent = True
 
-    def _tangent(self, c_u: float, c_v: float, c_a: float):
-        self.c_u.value, self.c_v.value, self.c_a.value = c_u, c_v, c_a
-        self._matrix.zeroEntries()
-        fem_petsc.assemble_matrix(self._matrix, self._jacobian)
-        self._matrix.assemble()
+    def _part(self, k: int):
+        """The k-th derivative (df/dq, df/dqd, df/dqdd) at the last evaluated state, projected."""
+        linear = self.linear[k] if self.dofs is not None else None
+        if self._jacobians[k] is None:
+            return linear if linear is not None else self.space.zeros_matrix()
+        if self._state is not None:  # a sampled evaluation packs its coefficients without the functions
+            for function, values in zip((self.U, self.V, self.A), self._state):
+                self._set(function, values)
+            self._state = None
+        matrix = self._matrices[k]
+        matrix.zeroEntries()
+        fem_petsc.assemble_matrix(matrix, self._jacobians[k])
+        matrix.assemble()
         if self.dofs is None:
-            return self.space.project_matrix(petsc_to_scipy(self._matrix))
-        block = petsc_to_scipy(self._matrix.createSubMatrix(self._sampled_dofs, self._sampled_dofs))
-        return self.phi_rows.T @ (block @ self.phi_rows) + sum(c * m for c, m in zip((c_u, c_v, c_a), self.linear)
-                                                              if c != 0)
+            return self.space.project_matrix(petsc_to_scipy(matrix))
+        block = petsc_to_scipy(matrix.createSubMatrix(self._sampled_dofs, self._sampled_dofs))
+        return self.phi_rows.T @ (block @ self.phi_rows) + linear
 
     def tangent_parts(self, needed=(True, True, True)):
         """(df/dq, df/dqd, df/dqdd) at the state of the last :meth:`evaluate`; None for a part not
         ``needed`` (a static solve needs df/dq only: one assembly instead of three)."""
-        unit = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-        return tuple(self._tangent(*c) if want else None for c, want in zip(unit, needed))
+        return tuple(self._part(k) if want else None for k, want in enumerate(needed))
 
     def kinetic_energy(self, q, qd) -> float:
         self._set(self.U, q)
@@ -186,6 +191,45 @@ class AssembledInternalForce:
 
     def damping_force(self, qd) -> np.ndarray:
         return self._damping @ qd
+
+
+class SampledCoefficients:
+    """A vector form on the sampled cells assembled from coefficients packed directly from (q, qd, qdd).
+
+    The packed coefficients of the cells (what ``dolfinx.fem.pack_coefficients`` gives: the weight and
+    the dofs of U, V, A on each cell) are an affine function of the reduced state, found once by packing
+    the columns of [Phi]; an evaluation is then one small product and DOLFINx's assembly with prepacked
+    coefficients, without setting the functions or DOLFINx's Python packing path."""
+
+    def __init__(self, form: fem.Form, functions, dofs: np.ndarray, phi_rows: np.ndarray):
+        self.form, self.dofs = form, dofs
+        self.constants = fem.pack_constants(form)
+        for function in functions:
+            function.x.array[:] = 0.0
+        (self.key, packed), = fem.pack_coefficients(form).items()
+        self.shape, self.offset = packed.shape, packed.ravel().copy()
+        columns = []
+        for function in functions:
+            for column in phi_rows.T:
+                function.x.array[dofs] = column
+                columns.append(fem.pack_coefficients(form)[self.key].ravel() - self.offset)
+            function.x.array[:] = 0.0
+        self.map = np.ascontiguousarray(np.column_stack(columns))
+        self.vector = np.zeros(form.function_spaces[0].dofmap.index_map.size_local
+                               * form.function_spaces[0].dofmap.index_map_bs)
+
+    def assemble(self, *state: np.ndarray) -> np.ndarray:
+        """The assembled vector at the sampled dofs at the reduced state (q, qd, qdd)."""
+        packed = (self.offset + self.map @ np.concatenate(state)).reshape(self.shape)
+        self.vector[:] = 0.0
+        fem.assemble_vector(self.vector, self.form, self.constants, {self.key: packed})
+        return self.vector[self.dofs]
+
+
+def _nonzero_form(derivative) -> fem.Form | None:
+    """The compiled form of a UFL derivative, or None where it vanishes identically."""
+    expanded = ufl.algorithms.expand_derivatives(derivative)
+    return None if expanded.empty() else fem.form(expanded)
 
 
 def internal_force(disc: BeamDiscretization, space, operators: LinearOperators, model,

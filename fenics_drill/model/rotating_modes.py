@@ -30,6 +30,7 @@ import scipy.sparse as sp
 from petsc4py import PETSc
 from slepc4py import SLEPc
 
+from fenics_drill.model.compiled import interrupt_in
 from fenics_drill.model.discretization import DRIVE, THETA_X, THETA_Y, THETA_Z, V, W, BeamDiscretization
 from fenics_drill.model.internal_force import internal_force
 from fenics_drill.model.modes import classify, shift_and_invert
@@ -52,7 +53,7 @@ class Divergence(ValueError):
 def held_space(disc: BeamDiscretization, held: tuple = DRIVE) -> FullSpace:
     """The full space without the support and stabiliser dofs and the ``held`` (field, end) pairs."""
     held_dofs = [disc.end_dof(field, end) for field, end in held]
-    return FullSpace(disc.ndofs, np.union1d(disc.support_dofs, held_dofs))
+    return FullSpace(disc, np.union1d(disc.support_dofs, held_dofs))
 
 
 @dataclass
@@ -82,7 +83,7 @@ def linearise_about_spin(disc: BeamDiscretization, operators: LinearOperators, m
     no friction, no bit-rock) joins K, like the wall springs."""
     # Evaluated where the drive's dofs are free, so that the spin is uniform up to x = 0, then
     # restricted to ``space``: the rigid spin must not ramp down over the first element.
-    supported = FullSpace(disc.ndofs, disc.support_dofs)
+    supported = FullSpace(disc)
     internal = internal_force(disc, supported, operators, model_switches)
     q_supported = supported.project(state)
     internal.evaluate(q_supported, supported.project(spin_velocity(disc, 1.0)), np.zeros_like(q_supported))
@@ -118,19 +119,35 @@ def _petsc(matrix: sp.csr_matrix) -> PETSc.Mat:
     return PETSc.Mat().createAIJ(A.shape, csr=(A.indptr, A.indices, A.data), comm=PETSc.COMM_SELF)
 
 
+#: Extra Krylov vectors tried, in turn, when SLEPc's TOAR fails to reorder its Schur form.
+SUBSPACE_RETRIES = (0, 8, 16)
+
+
 def _solve_pep(K: PETSc.Mat, D: PETSc.Mat, M: PETSc.Mat, nev: int) -> SLEPc.PEP:
-    pep = SLEPc.PEP().create(PETSc.COMM_SELF)
-    pep.setOperators([K, D, M])
-    pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
-    pep.setType(SLEPc.PEP.Type.TOAR)
-    pep.setDimensions(nev=nev, ncv=max(2 * nev, nev + 24))
-    pep.setScale(SLEPc.PEP.Scale.SCALAR)
-    pep.setTarget(0.0)
-    pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
-    shift_and_invert(pep.getST(), PETSc.PC.Type.LU)
-    pep.setTolerances(tol=1e-10, max_it=500)
-    pep.solve()
-    return pep
+    """TOAR with shift-and-invert about 0.  The v and w modes of a string come in exactly degenerate pairs;
+    LAPACK's reordering of the projected Schur form (trexc, in SLEPc's DSSort) can fail to swap such a pair
+    for one round-off (it did for one sparsity pattern of K).  Another subspace size builds another
+    projected problem, so the solve is tried again with more Krylov vectors before giving up."""
+    for extra in SUBSPACE_RETRIES:
+        pep = SLEPc.PEP().create(PETSc.COMM_SELF)
+        pep.setOperators([K, D, M])
+        pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
+        pep.setType(SLEPc.PEP.Type.TOAR)
+        pep.setDimensions(nev=nev, ncv=min(max(2 * nev, nev + 24) + extra, K.getSize()[0]))
+        pep.setScale(SLEPc.PEP.Scale.SCALAR)
+        pep.setTarget(0.0)
+        pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
+        shift_and_invert(pep.getST(), PETSc.PC.Type.LU)
+        pep.setTolerances(tol=1e-10, max_it=500)
+        try:
+            pep.solve()
+            return pep
+        except (PETSc.Error, SystemError) as error:  # petsc4py may report PETSc's error as a SystemError
+            pep.destroy()
+            if interrupt_in(error) is not None:
+                raise KeyboardInterrupt from error
+            failure = error
+    raise RuntimeError(f"SLEPc's PEP failed with {len(SUBSPACE_RETRIES)} subspace sizes") from failure
 
 
 def kinetic_energy_fractions(mass: sp.csr_matrix, field_of_dof: np.ndarray, vectors: np.ndarray) -> np.ndarray:

@@ -19,6 +19,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from fenics_drill.model.banded_saddle import BandedSaddle
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.enrichment import augment, enrich
 from fenics_drill.model.modes import reduction_bands, select_modes, solve_modes, stuck_bit_modes
@@ -30,7 +31,7 @@ class SaddleFactorisation:
     that keeps its tangent (modified Newton) solves without factorising again."""
 
     def __init__(self, factorise):
-        self.factorise = factorise  # (tangent, constraints) -> (solve(rhs), scale k)
+        self.factorise = factorise  # (tangent, constraints) -> solve(rhs_q, rhs_c) -> (dq, mu)
         self.key = self.value = None
 
     def __call__(self, tangent, constraints):
@@ -83,19 +84,30 @@ class ModalSpace:
     def solve(self, matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
         return sla.solve(matrix, rhs, check_finite=False)
 
+    def combine(self, terms) -> np.ndarray:
+        """sum of c A over the (c, A) of ``terms``: a tangent from its parts."""
+        out = np.zeros((self.size, self.size))
+        for c, matrix in terms:
+            out += c * matrix
+        return out
+
     @staticmethod
     def _factorise(tangent: np.ndarray, constraints: np.ndarray):
         m = constraints.shape[0]
         k = constraint_scale(tangent, constraints)
         system = np.block([[tangent, k * constraints.T], [k * constraints, np.zeros((m, m))]])
         factors = sla.lu_factor(system, check_finite=False)
-        return (lambda rhs: sla.lu_solve(factors, rhs, check_finite=False)), k
+        n = tangent.shape[0]
+
+        def solve(rhs_q, rhs_c):
+            x = sla.lu_solve(factors, np.concatenate([rhs_q, k * rhs_c]), check_finite=False)
+            return x[:n], k * x[n:]
+
+        return solve
 
     def saddle_solve(self, tangent: np.ndarray, constraints: np.ndarray, rhs_q: np.ndarray, rhs_c: np.ndarray):
         """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76) (LU kept for the same J and B)."""
-        solve, k = self._saddle(tangent, constraints)
-        x = solve(np.concatenate([rhs_q, k * rhs_c]))
-        return x[: self.size], k * x[self.size :]
+        return self._saddle(tangent, constraints)(rhs_q, rhs_c)
 
 
 class FullSpace:
@@ -103,10 +115,14 @@ class FullSpace:
 
     sparse = True
 
-    def __init__(self, ndofs: int, support_dofs: np.ndarray):
-        self.free = np.setdiff1d(np.arange(ndofs), support_dofs)
+    def __init__(self, disc: BeamDiscretization, fixed: np.ndarray | None = None):
+        """The dofs of ``disc`` but the ``fixed`` ones (default: the supports and stabilisers)."""
+        ndofs = disc.ndofs
+        self.free = np.setdiff1d(np.arange(ndofs), disc.support_dofs if fixed is None else fixed)
         self.ndofs = ndofs
         self._saddle = SaddleFactorisation(self._factorise)
+        # the free dofs numbered along the string: an element couples only neighbours in this order
+        self._band_order = np.argsort(disc.dof_coordinates[self.free], kind="stable")
         self.phi = sp.csr_matrix(
             (np.ones(self.free.size), (self.free, np.arange(self.free.size))), shape=(ndofs, self.free.size)
         )
@@ -124,7 +140,11 @@ class FullSpace:
         return np.asarray(vector)[self.free]
 
     def project_matrix(self, matrix: sp.spmatrix) -> sp.csr_matrix:
-        return sp.csr_matrix(matrix)[self.free][:, self.free]
+        """The free rows and columns of ``matrix``, without the zeros its sparsity pattern holds (an
+        assembled form's pattern couples every field of an element, most of them with zeros)."""
+        projected = sp.csr_matrix(matrix)[self.free][:, self.free]
+        projected.eliminate_zeros()
+        return projected
 
     def rows(self, dofs: np.ndarray) -> sp.csr_matrix:
         return self.phi[np.asarray(dofs)]
@@ -135,18 +155,24 @@ class FullSpace:
     def solve(self, matrix, rhs: np.ndarray) -> np.ndarray:
         return spla.spsolve(sp.csc_matrix(matrix), rhs)
 
-    @staticmethod
-    def _factorise(tangent, constraints):
-        k = constraint_scale(tangent, constraints)
-        B = sp.csr_matrix(k * np.asarray(constraints))
-        return spla.splu(sp.bmat([[tangent, B.T], [B, None]], format="csc")).solve, k
+    def combine(self, terms) -> sp.coo_matrix:
+        """sum of c A over the (c, A) of ``terms``, as the entries of all terms side by side (a COO matrix
+        whose repeated entries add up): no sparse sums, whose bookkeeping costs more than the banded LU."""
+        parts = [sp.coo_matrix(matrix) for _, matrix in terms]
+        if not parts:
+            return sp.coo_matrix((self.size, self.size))
+        data = np.concatenate([c * part.data for (c, _), part in zip(terms, parts)])
+        rows = np.concatenate([part.row for part in parts])
+        columns = np.concatenate([part.col for part in parts])
+        return sp.coo_matrix((data, (rows, columns)), shape=(self.size, self.size))
+
+    def _factorise(self, tangent, constraints) -> BandedSaddle:
+        return BandedSaddle(tangent, constraints, self._band_order)
 
     def saddle_solve(self, tangent, constraints, rhs_q: np.ndarray, rhs_c: np.ndarray):
-        """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76), with a sparse LU (kept for the
-        same J and B)."""
-        solve, k = self._saddle(tangent, constraints)
-        x = solve(np.concatenate([rhs_q, k * rhs_c]))
-        return x[: self.size], k * x[self.size :]
+        """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76), with a banded LU and the held dofs
+        eliminated (:mod:`fenics_drill.model.banded_saddle`; kept for the same J and B)."""
+        return self._saddle(tangent, constraints)(rhs_q, rhs_c)
 
 
 def weighted_product(rows_a, weights: np.ndarray, rows_b):
@@ -168,7 +194,7 @@ def solution_space(scene, disc: BeamDiscretization, operators: LinearOperators):
     'none'; all modes of the band B (for spectra) either way."""
     modes = solve_modes(disc, scene.modal.f_star_max, operators.mass)
     if scene.reduction.rule == "none":
-        return FullSpace(disc.ndofs, disc.support_dofs), None, modes, {}, None
+        return FullSpace(disc), None, modes, {}, None
     basis = modes.select(select_modes(modes, scene))
     vectors, stuck = basis.vectors, None
     if scene.reduction.rule == "auto" and scene.model.bit_rock:

@@ -51,7 +51,7 @@ def steady_state(scene, disc: BeamDiscretization, operators, preload: float) -> 
     switches = {"gravity": on_wall and scene.model.gravity, "contact": on_wall and scene.model.contact,
                 "bit_rock": False}
     at_rest = scene.with_changes(model=switches)
-    model = DrillstringModel(at_rest, disc, FullSpace(disc.ndofs, disc.support_dofs), operators)
+    model = DrillstringModel(at_rest, disc, FullSpace(disc), operators)
     if preload != 0:
         model = model.with_added_force(AxialTipLoad(disc, model.space, preload))
     if not model.forces:
