@@ -44,7 +44,8 @@ def constraint_scale(tangent, constraints) -> float:
     """Factor k for the rows of [B] in the saddle system (76): with k [B] the constraint rows
     have the size of the tangent's, otherwise the system is singular to working precision."""
     diagonal = np.abs(tangent.diagonal()).max()
-    return diagonal / max(np.abs(np.asarray(constraints)).max(), 1e-300) if diagonal > 0 else 1.0
+    largest = np.abs(np.asarray(constraints)).max(initial=0.0)  # no rows: a hook load with a top drive
+    return diagonal / largest if diagonal > 0 and largest > 0 else 1.0
 
 
 class ModalSpace:

@@ -62,6 +62,20 @@ def test_a_hook_load_drills_where_the_paper_law_holds_the_weight_on_bit():
     assert np.all(force == 20e3)
 
 
+@pytest.mark.parametrize("rule", ["none", "auto"])
+def test_a_hook_load_with_a_speed_controller_holds_no_dof(rule):
+    """A hook load and a PI top drive together leave [B] without rows (the saddle system is J alone),
+    reduced or full: the load is applied as set and the top turns at Omega on average.  The reduced model
+    stopped with "zero-size array" before (the scale of an empty [B])."""
+    scene, simulation, (t, _, _, top_spin, force, _) = run_short(
+        "drive.mode='hook_load'", "drive.weight_on_bit=20e3", "drive.controller='pi'", f"reduction.rule='{rule}'",
+        t_end=0.6)
+    assert simulation.model.constraints.shape[0] == 0
+    assert np.all(force == 20e3)
+    # as in the controller test below: the PI's integral removes the steady speed error
+    assert late_mean(t, top_spin, 0.3) == pytest.approx(scene.drive.rotation_speed, rel=1e-3)
+
+
 @pytest.mark.parametrize("controller", ["pi", "soft_torque"])
 def test_a_speed_controller_holds_the_set_speed_and_its_motor_work_closes_the_budget(controller):
     """The PI's integral removes the steady speed error: the top turns at Omega on average.  With
