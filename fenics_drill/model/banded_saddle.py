@@ -1,8 +1,9 @@
 """The saddle-point system (76) of a full-order model, solved as a banded matrix.
 
 A beam on an interval mesh couples each dof only with those of its own elements, so once the dofs are
-numbered along the string (by their x) the tangent J is a band about as wide as one element's dofs.  In the full space every row of [B] holds one dof (u(0) or theta_x(0)), so the
-constraints are eliminated exactly instead of bordering the matrix:
+numbered along the string (by their x) the tangent J is a band about as wide as one element's dofs.
+In the full space every row of [B] holds one dof (u(0) or theta_x(0)), so the constraints are
+eliminated exactly instead of bordering the matrix:
 
     x_c = g / b,   A x = r - J[:, c] x_c  with row and column c of J replaced by the identity,
     mu = (r_c - (J x)_c) / b

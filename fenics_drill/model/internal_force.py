@@ -122,7 +122,8 @@ class AssembledInternalForce:
         self._vector = fem_petsc.create_vector(self._residual.function_spaces)
         # one form per derivative df/dq, df/dqd, df/dqdd (None where f does not depend on it): each part is
         # assembled by a kernel of its own, not by the whole Jacobian's kernel with two coefficients zero
-        self._jacobians = tuple(_nonzero_form(ufl.derivative(residual, field, dU)) for field in (self.U, self.V, self.A))
+        self._jacobians = tuple(_nonzero_form(ufl.derivative(residual, field, dU))
+                                for field in (self.U, self.V, self.A))
         self._matrices = tuple(fem_petsc.create_matrix(form) if form is not None else None for form in self._jacobians)
         self._damping = space.project_matrix(operators.damping)  # (45) is linear: reused for the budget
         self._packing = SampledCoefficients(self._residual, (self.U, self.V, self.A), self.dofs, self.phi_rows) \
