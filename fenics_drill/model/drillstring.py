@@ -224,6 +224,14 @@ class DrillstringModel:
             out.tangent_of = lambda: self._tangent(tangent_coefficients, parts, evaluations, drive)
         return out
 
+    def kink_step(self, evaluation: Evaluation, dq: np.ndarray, c_v: float) -> float | None:
+        """The fraction of a Newton update dq (qd moves by c_v dq) just past the first kink of a point
+        force's law along it (the bit-rock law (20) at u_dot_bit = 0), or None."""
+        steps = [force.kink_step(evaluation.forces[force.name], dq, c_v) for force in self.forces
+                 if hasattr(force, "kink_step")]
+        steps = [s for s in steps if s is not None]
+        return min(steps) if steps else None
+
     def _tangent(self, coefficients, internal_parts, evaluations, drive):
         """c_u dr/dq + c_v dr/dqd + c_a dr/dqdd of the residual of :meth:`evaluate`."""
         c_u, c_v, c_a = coefficients

@@ -150,7 +150,8 @@ class NewmarkNewton:
             return evaluate(q, mu, refresh=slow and stale)
 
         result = saddle_newton(trial, self.model.space, self.model.constraints, target,
-                               q, mu, ev, check, self.max_iterations, reuse_rate=TANGENT_REUSE_RATE)
+                               q, mu, ev, check, self.max_iterations, reuse_rate=TANGENT_REUSE_RATE,
+                               kink_step=lambda ev, dq: self.model.kink_step(ev, dq, c_v))
         if result is None:
             raise NewtonFailure(f"Newton did not converge in {self.max_iterations} iterations at dt = {dt:.3e} s")
         return result

@@ -20,20 +20,24 @@ HALVINGS = 6
 ARMIJO = 1e-4
 
 
-def backtrack(trial, norm0: float, step: float = 1.0):
+def backtrack(trial, norm0: float, step: float = 1.0, kink: float | None = None):
     """Largest step = step / 2^k (k < HALVINGS) whose ``trial(step) -> (norm, payload)`` decreases
-    the norm enough; returns (step, norm, payload) of the accepted (or last) trial."""
-    for _ in range(HALVINGS):
+    the norm enough; returns (step, norm, payload) of the accepted (or last) trial.
+
+    ``kink``: the step just past the first kink of a force law along the update (a branch the tangent
+    did not see).  When the first trial fails, the kink is tried next and the halving goes on from it."""
+    for attempt in range(HALVINGS):
         norm, payload = trial(step)
         if norm < (1.0 - ARMIJO * step) * norm0:
             break
-        step *= 0.5
+        step = kink if attempt == 0 and kink is not None and kink < step else 0.5 * step
     return step, norm, payload
 
 
 def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np.ndarray, q: np.ndarray,
                   mu: np.ndarray, evaluation, check: Callable, max_iterations: int,
-                  first_step: Callable[[np.ndarray], float] | None = None, reuse_rate: float = 0.0):
+                  first_step: Callable[[np.ndarray], float] | None = None, reuse_rate: float = 0.0,
+                  kink_step: Callable | None = None):
     """Iterate from (q, mu), whose ``evaluation`` (with ``.residual`` and ``.tangent``) is given.
 
     ``evaluate(q, mu)`` evaluates a trial state.  Before each update
@@ -42,6 +46,8 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
     line search (default 1).  With ``reuse_rate`` > 0 the tangent of an earlier iterate is kept
     while each full update shrinks the residual norm at least by that factor (a modified Newton with a
     convergence-rate test; Deuflhard 2004, Sec. 2.1); a slower or damped update takes a fresh one.
+    ``kink_step(evaluation, dq)`` gives the fraction of an update just past the first kink of a force
+    law along it (None if there is none before the full update): the line search's second trial.
     Returns None when ``max_iterations`` updates did not satisfy ``check``.
     """
     norm = np.linalg.norm(evaluation.residual)
@@ -60,7 +66,8 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
             return np.linalg.norm(result.residual), result
 
         previous = norm
-        step, norm, evaluation = backtrack(trial, norm, 1.0 if first_step is None else first_step(dq))
+        kink = kink_step(evaluation, dq) if kink_step is not None else None
+        step, norm, evaluation = backtrack(trial, norm, 1.0 if first_step is None else first_step(dq), kink)
         q, mu = q + step * dq, mu + step * dmu
         if step < 1.0 or norm > reuse_rate * previous:
             tangent = None

@@ -43,6 +43,17 @@ def torque_regularisation_slope(omega):
     return 1.0 - np.tanh(omega) ** 2 + 2.0 * (1.0 - omega**2) / (1.0 + omega**2) ** 2
 
 
+#: A Newton update that crosses a kink is cut this much (relatively) past it, on the new branch.
+KINK_PAST = 1e-6
+
+
+def step_past_kink(value: float, change: float) -> float | None:
+    """The step s in (0, 1) just past where value + s change crosses zero (None if it does not)."""
+    if value == 0.0 or change == 0.0 or value * change > 0.0 or abs(change) <= abs(value):
+        return None
+    return min(-value / change * (1.0 + KINK_PAST), 1.0)
+
+
 @dataclass
 class BitForces(ForceEvaluation):
     """The bit's state and reaction; ``generalised`` is [Phi]^T of (51), none of it conservative."""
@@ -107,6 +118,11 @@ class BitRock:
         laws = {"bit_rock_force": self.row_u.T @ np.array([force]), "bit_rock_torque": self.row_tx.T @ np.array([torque])}
         return BitForces(generalised, 0.0, laws, u_dot, omega, force, torque, d_force, d_torque_velocity,
                          d_torque_spin)
+
+    def kink_step(self, forces: BitForces, dq: np.ndarray, c_v: float) -> float | None:
+        """The fraction of a Newton update dq (which moves qd by c_v dq) just past u_dot_bit = 0, where
+        (20) switches between no force and its steepest slope; None if the update does not cross it."""
+        return step_past_kink(forces.bit_velocity, c_v * float((self.row_u @ dq)[0]))
 
     def tangent(self, forces: BitForces, c_u: float, c_v: float):
         """c_v d f_BR / d qd (the law depends on velocities only, so c_u plays no part)."""

@@ -1,0 +1,62 @@
+"""Newton's line search across a kink of a force law (the bit-rock law (20) at u_dot_bit = 0)."""
+
+import numpy as np
+import pytest
+
+from fenics_drill.model.forces.bit_rock import KINK_PAST, step_past_kink
+from fenics_drill.model.spaces import ModalSpace
+from fenics_drill.solvers.newton import saddle_newton
+
+#: r(y) = y + K max(y, 0) - b: a unit spring, and a stiff one that acts only for y > 0 (as F_BR acts only
+#: for u_dot_bit > 0); its root is y* = b / (1 + K).
+STIFF, LOAD = 1e4, 1.0
+
+
+class Kinked:
+    def __init__(self, y):
+        self.residual = np.array([y[0] + STIFF * max(y[0], 0.0) - LOAD])
+        self.tangent = np.array([[1.0 + (STIFF if y[0] > 0 else 0.0)]])
+        self.y = y[0]
+
+
+def solve(with_kink: bool):
+    evaluations = []
+
+    def evaluate(y, mu):
+        evaluations.append(y[0])
+        return Kinked(y)
+
+    def check(iteration, y, mu, ev, norm, gap):
+        return (y[0], iteration) if norm <= 1e-12 * LOAD else None
+
+    def kink_step(ev, dy):
+        return step_past_kink(ev.y, dy[0])
+
+    y0 = np.array([-1.0])
+    result = saddle_newton(evaluate, ModalSpace(np.eye(1)), np.zeros((0, 1)), np.zeros(0), y0, np.zeros(0),
+                           Kinked(y0), check, 40, kink_step=kink_step if with_kink else None)
+    return result, len(evaluations)
+
+
+def test_the_line_search_tries_the_step_just_past_a_kink_and_then_converges_on_the_new_branch():
+    (root, updates), evaluations = solve(with_kink=True)
+    assert root == pytest.approx(LOAD / (1 + STIFF), rel=1e-12)  # the residual's own tolerance
+    # from y = -1 the unit spring's update overshoots to y = b, the kink trial lands just past y = 0, and
+    # the next update on the stiff branch (linear) is exact: converged at the third check, after three trials
+    assert updates == 3 and evaluations == 3
+    # halving alone lands ever nearer the kink from either side, with the tangent of the side it left
+    plain, _ = solve(with_kink=False)
+    assert plain is None
+
+
+@pytest.mark.parametrize("value, change", [(-1.0, 3.0), (2.0, -2.5), (1e-6, -1.0)])
+def test_the_kink_step_lands_just_past_zero_on_the_far_side(value, change):
+    s = step_past_kink(value, change)
+    landed = value + s * change
+    assert np.sign(landed) == np.sign(value + change)
+    assert abs(landed) == pytest.approx(KINK_PAST * abs(value), rel=1e-9)
+
+
+@pytest.mark.parametrize("value, change", [(1.0, 2.0), (-1.0, 0.5), (0.0, 1.0), (1.0, 0.0)])
+def test_no_kink_step_where_the_update_does_not_cross_zero(value, change):
+    assert step_past_kink(value, change) is None
