@@ -66,7 +66,7 @@ class BandedSaddle:
     """The factorised saddle matrix [[J, B^T], [B, 0]] of (76), J sparse, its dofs renumbered by ``order``."""
 
     def __init__(self, tangent: sp.spmatrix, constraints, order: np.ndarray):
-        tangent = sp.coo_matrix(tangent)
+        tangent = tangent if isinstance(tangent, sp.coo_matrix) else sp.coo_matrix(tangent)
         n = tangent.shape[0]
         self.held, self.coefficients = held_dofs(constraints)
         held_slot = np.full(n, -1, dtype=np.int64)

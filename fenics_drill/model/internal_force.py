@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import dolfinx.fem.petsc as fem_petsc
 import numpy as np
+import scipy.sparse as sp
 import ufl
 from dolfinx import fem
 from dolfinx.mesh import meshtags
@@ -124,7 +125,12 @@ class AssembledInternalForce:
         # assembled by a kernel of its own, not by the whole Jacobian's kernel with two coefficients zero
         self._jacobians = tuple(_nonzero_form(ufl.derivative(residual, field, dU))
                                 for field in (self.U, self.V, self.A))
-        self._matrices = tuple(fem_petsc.create_matrix(form) if form is not None else None for form in self._jacobians)
+        if sample is None:  # DOLFINx's own CSR matrices, read at the entries that matter
+            self._matrices = tuple(TangentEntries(form, space, (self.U, self.V, self.A)) if form is not None
+                                   else None for form in self._jacobians)
+        else:
+            self._matrices = tuple(fem_petsc.create_matrix(form) if form is not None else None
+                                   for form in self._jacobians)
         self._damping = space.project_matrix(operators.damping)  # (45) is linear: reused for the budget
         self._packing = SampledCoefficients(self._residual, (self.U, self.V, self.A), self.dofs, self.phi_rows) \
             if sample is not None else None
@@ -166,11 +172,11 @@ class AssembledInternalForce:
                 self._set(function, values)
             self._state = None
         matrix = self._matrices[k]
+        if self.dofs is None:
+            return matrix.assemble()
         matrix.zeroEntries()
         fem_petsc.assemble_matrix(matrix, self._jacobians[k])
         matrix.assemble()
-        if self.dofs is None:
-            return self.space.project_matrix(petsc_to_scipy(matrix))
         block = petsc_to_scipy(matrix.createSubMatrix(self._sampled_dofs, self._sampled_dofs))
         return self.phi_rows.T @ (block @ self.phi_rows) + linear
 
@@ -225,6 +231,48 @@ class SampledCoefficients:
         self.vector[:] = 0.0
         fem.assemble_vector(self.vector, self.form, self.constants, {self.key: packed})
         return self.vector[self.dofs]
+
+
+class TangentEntries:
+    """A tangent form assembled into DOLFINx's CSR matrix and read as COO at the entries that are not zero
+    for every state and, in the full space, couple two free dofs (renumbered as the space's unknowns).
+
+    The form's pattern couples every field of an element with every other, most of them with zeros
+    (189 k entries, 50 k nonzero on 1000 elements): the entries to keep are those nonzero at two random
+    states, found once, so an assembly is DOLFINx's kernel loop and one gather."""
+
+    #: Random states that find the entries to keep: displacements and rates of this size (rotations in
+    #: rad), so that no term of the energies' polynomials and sines vanishes by accident.
+    PROBE_SIZE, PROBES = 0.3, 2
+
+    def __init__(self, form: fem.Form, space, functions):
+        self.form, self.matrix, self.space = form, fem.create_matrix(form), space
+        n_dofs = self.matrix.indptr.size - 1
+        rows = np.repeat(np.arange(n_dofs), np.diff(self.matrix.indptr))
+        # the full space keeps the free dofs, renumbered; a modal space projects every dof's entries
+        position = space.position if space.sparse else np.arange(n_dofs)
+        self.shape = (space.size,) * 2 if space.sparse else (n_dofs,) * 2
+        kept = (position[rows] >= 0) & (position[self.matrix.indices] >= 0)
+        saved = [function.x.array.copy() for function in functions]
+        rng, nonzero = np.random.default_rng(0), np.zeros(self.matrix.data.size, dtype=bool)
+        for _ in range(self.PROBES):
+            for function in functions:
+                function.x.array[:] = self.PROBE_SIZE * rng.standard_normal(function.x.array.size)
+            nonzero |= self._assembled() != 0.0
+        for function, values in zip(functions, saved):
+            function.x.array[:] = values
+        self.keep = np.flatnonzero(kept & nonzero)
+        self.rows, self.columns = position[rows[self.keep]], position[self.matrix.indices[self.keep]]
+
+    def _assembled(self) -> np.ndarray:
+        self.matrix.data[:] = 0.0
+        fem.assemble_matrix(self.matrix, self.form)
+        return self.matrix.data
+
+    def assemble(self):
+        """The projected form at the functions' current values (COO in the full space, dense in a modal one)."""
+        entries = sp.coo_matrix((self._assembled()[self.keep], (self.rows, self.columns)), shape=self.shape)
+        return entries if self.space.sparse else self.space.project_matrix(entries)
 
 
 def _nonzero_form(derivative) -> fem.Form | None:

@@ -40,6 +40,62 @@ class SaddleFactorisation:
         return self.value
 
 
+class ModalPointRows:
+    """The values of a few dofs in a modal space: the rows P = [Phi]_dofs (k x N_red), dense."""
+
+    def __init__(self, rows: np.ndarray):
+        self.matrix = np.ascontiguousarray(rows)
+
+    def values(self, x: np.ndarray) -> np.ndarray:
+        """P x: the dofs' values of a reduced vector."""
+        return self.matrix @ x
+
+    def spread(self, point_values: np.ndarray) -> np.ndarray:
+        """P^T f: the generalised force of point forces f on the dofs."""
+        return self.matrix.T @ point_values
+
+    def block(self, jacobian: np.ndarray) -> np.ndarray:
+        """P^T A P: the tangent of a point law with Jacobian A (k x k) on the dofs."""
+        return self.matrix.T @ jacobian @ self.matrix
+
+    def subset(self, indices) -> "ModalPointRows":
+        return ModalPointRows(self.matrix[indices])
+
+    def dense(self) -> np.ndarray:
+        return self.matrix
+
+
+class SelectedPointRows:
+    """The values of a few dofs in the full space: each row selects one free dof (or none, for a dof held
+    by a support), so P q, P^T f and P^T A P are gathers and scatters, not sparse products."""
+
+    def __init__(self, positions: np.ndarray, size: int):
+        self.positions, self.size = np.asarray(positions, dtype=np.int64), size  # -1: a supported dof
+        self.free = self.positions >= 0
+
+    def values(self, x: np.ndarray) -> np.ndarray:
+        return np.where(self.free, np.asarray(x)[np.maximum(self.positions, 0)], 0.0)
+
+    def spread(self, point_values: np.ndarray) -> np.ndarray:
+        out = np.zeros(self.size)
+        np.add.at(out, self.positions[self.free], np.asarray(point_values, dtype=float)[self.free])
+        return out
+
+    def block(self, jacobian: np.ndarray) -> sp.coo_matrix:
+        kept = np.flatnonzero(self.free)
+        rows, columns = np.meshgrid(self.positions[kept], self.positions[kept], indexing="ij")
+        data = np.asarray(jacobian, dtype=float)[np.ix_(kept, kept)]
+        return sp.coo_matrix((data.ravel(), (rows.ravel(), columns.ravel())), shape=(self.size, self.size))
+
+    def subset(self, indices) -> "SelectedPointRows":
+        return SelectedPointRows(self.positions[indices], self.size)
+
+    def dense(self) -> np.ndarray:
+        out = np.zeros((self.positions.size, self.size))
+        out[np.flatnonzero(self.free), self.positions[self.free]] = 1.0
+        return out
+
+
 def constraint_scale(tangent, constraints) -> float:
     """Factor k for the rows of [B] in the saddle system (76): with k [B] the constraint rows
     have the size of the tangent's, otherwise the system is singular to working precision."""
@@ -78,6 +134,10 @@ class ModalSpace:
     def rows(self, dofs: np.ndarray) -> np.ndarray:
         """The rows of [Phi] of some dofs: maps q to the values of those dofs."""
         return self.phi[np.asarray(dofs)]
+
+    def point_rows(self, dofs) -> ModalPointRows:
+        """P of a few dofs (the bit's, the top's): q -> their values, with its products."""
+        return ModalPointRows(self.phi[np.asarray(dofs)])
 
     def zeros_matrix(self) -> np.ndarray:
         return np.zeros((self.size, self.size))
@@ -121,6 +181,8 @@ class FullSpace:
         ndofs = disc.ndofs
         self.free = np.setdiff1d(np.arange(ndofs), disc.support_dofs if fixed is None else fixed)
         self.ndofs = ndofs
+        self.position = np.full(ndofs, -1, dtype=np.int64)  # of each dof among the free ones (-1: held)
+        self.position[self.free] = np.arange(self.free.size)
         self._saddle = SaddleFactorisation(self._factorise)
         # the free dofs numbered along the string: an element couples only neighbours in this order
         self._band_order = np.argsort(disc.dof_coordinates[self.free], kind="stable")
@@ -150,6 +212,10 @@ class FullSpace:
     def rows(self, dofs: np.ndarray) -> sp.csr_matrix:
         return self.phi[np.asarray(dofs)]
 
+    def point_rows(self, dofs) -> SelectedPointRows:
+        """P of a few dofs (the bit's, the top's): q -> their values, with its products."""
+        return SelectedPointRows(self.position[np.asarray(dofs)], self.size)
+
     def zeros_matrix(self) -> sp.csr_matrix:
         return sp.csr_matrix((self.size, self.size))
 
@@ -159,7 +225,7 @@ class FullSpace:
     def combine(self, terms) -> sp.coo_matrix:
         """sum of c A over the (c, A) of ``terms``, as the entries of all terms side by side (a COO matrix
         whose repeated entries add up): no sparse sums, whose bookkeeping costs more than the banded LU."""
-        parts = [sp.coo_matrix(matrix) for _, matrix in terms]
+        parts = [matrix if isinstance(matrix, sp.coo_matrix) else sp.coo_matrix(matrix) for _, matrix in terms]
         if not parts:
             return sp.coo_matrix((self.size, self.size))
         data = np.concatenate([c * part.data for (c, _), part in zip(terms, parts)])
@@ -174,14 +240,6 @@ class FullSpace:
         """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76), with a banded LU and the held dofs
         eliminated (:mod:`fenics_drill.model.banded_saddle`; kept for the same J and B)."""
         return self._saddle(tangent, constraints)(rhs_q, rhs_c)
-
-
-def weighted_product(rows_a, weights: np.ndarray, rows_b):
-    """rows_a^T diag(weights) rows_b for dense or sparse rows of [Phi]: the projection of a
-    pointwise (diagonal) Jacobian d F_a / d y_b acting at a set of dofs."""
-    if sp.issparse(rows_b):
-        return rows_a.T @ (sp.diags(weights) @ rows_b)
-    return rows_a.T @ (weights[:, None] * rows_b)
 
 
 class BasisError(ValueError):

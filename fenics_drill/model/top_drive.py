@@ -34,7 +34,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from fenics_drill.model.discretization import THETA_X, U
-from fenics_drill.model.spaces import weighted_product
 
 AXIAL, ROTATION = 0, 1
 
@@ -65,8 +64,8 @@ class TopDrive:
     """The drive of a scene in a solution space: multiplier rows for what it holds, loads for the rest."""
 
     def __init__(self, drive, disc, space):
-        self.rows = space.rows([disc.end_dof(U, 0), disc.end_dof(THETA_X, 0)])  # 2 x N: q -> u(0), theta_x(0)
-        self.sparse = space.sparse
+        self.rows = space.point_rows([disc.end_dof(U, 0), disc.end_dof(THETA_X, 0)])  # q -> u(0), theta_x(0)
+        self.top = self.rows.subset([1])  # q -> theta_x(0)
         self.rate = np.array([drive.axial_velocity, drive.rotation_speed])  # V0, Omega
         self.held = np.array([drive.mode == "velocity", drive.controller == "stiff"])
         self.weight_on_bit = drive.weight_on_bit
@@ -86,8 +85,7 @@ class TopDrive:
     @property
     def constraints(self):
         """[B] of (72): the rows of the dofs the drive holds (k x N_red, k = 0, 1 or 2)."""
-        rows = self.rows[np.flatnonzero(self.held)]
-        return rows.toarray() if self.sparse else rows
+        return self.rows.subset(np.flatnonzero(self.held)).dense()
 
     @property
     def held_rate(self) -> np.ndarray:
@@ -130,7 +128,7 @@ class TopDrive:
 
     def _top(self, vector: np.ndarray) -> float:
         """theta_x(0) of a displacement (or its rate of a velocity)."""
-        return float(np.ravel(self.rows[[1]] @ vector)[0])
+        return float(self.top.values(vector)[0])
 
     def _current_integral(self, angle: float, t: float) -> float:
         """z at time t: z_n + int (Omega - theta_x_dot(0)) dt = z_n + Omega (t - t_n) - (theta - theta_n)."""
@@ -153,15 +151,13 @@ class TopDrive:
             torque = float(np.clip(unlimited, -self.torque_limit, self.torque_limit))
             if abs(unlimited) < self.torque_limit:
                 d_angle, d_speed = -self.gains[1], -self.gains[0]
-        generalised = self.rows.T @ np.array([force, torque])
-        return DriveLoads(np.asarray(generalised).ravel(), force, torque, d_angle, d_speed)
+        return DriveLoads(self.rows.spread(np.array([force, torque])), force, torque, d_angle, d_speed)
 
     def tangent(self, loads: DriveLoads, c_u: float, c_v: float):
         """c_u df/dq + c_v df/dqd of the applied loads (None when the drive holds everything)."""
         if self.held[ROTATION]:
             return None
-        row = self.rows[[1]]
-        return weighted_product(row, np.array([c_u * loads.d_torque_angle + c_v * loads.d_torque_speed]), row)
+        return self.top.block(np.array([[c_u * loads.d_torque_angle + c_v * loads.d_torque_speed]]))
 
     def applied(self, mu: np.ndarray, loads: DriveLoads) -> tuple[float, float]:
         """(force along x, torque) the drive applies at x = 0: -lambda for a held dof, the load otherwise."""
@@ -177,17 +173,15 @@ class TopDrive:
         """[Phi]^T J_td theta_x_ddot(0) (zero without a top drive)."""
         if self.inertia == 0.0:
             return np.zeros_like(qdd)
-        row = self.rows[[1]]
-        return np.asarray(row.T @ (self.inertia * (row @ qdd))).ravel()
+        return self.top.spread(self.inertia * self.top.values(qdd))
 
     def inertia_tangent(self, c_a: float):
-        row = self.rows[[1]]
-        return weighted_product(row, np.array([c_a * self.inertia]), row) if self.inertia else None
+        return self.top.block(np.array([[c_a * self.inertia]])) if self.inertia else None
 
     def kinetic_energy(self, qd: np.ndarray) -> float:
         return 0.5 * self.inertia * self._top(qd) ** 2 if self.inertia else 0.0
 
     def velocities(self, qd: np.ndarray) -> tuple[float, float]:
         """u_dot(0), theta_x_dot(0)."""
-        u, tx = np.ravel(self.rows @ qd)
+        u, tx = self.rows.values(qd)
         return float(u), float(tx)

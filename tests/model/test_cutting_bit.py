@@ -76,7 +76,7 @@ def test_the_cutting_law_tangent_matches_finite_differences(cutting_model):
     and with the surface's slope (the delay's d(depth)/d(angle))."""
     scene, model = cutting_model
     bit = model.force("bit_rock").fresh()
-    rows = bit.rows.toarray()
+    rows = bit.rows.dense()
     q0 = np.zeros(model.size)
     bit.begin(0.0, q0)
     angles = np.linspace(0.05, 2.0, 40)

@@ -12,7 +12,6 @@ from fenics_drill.model import forces
 from fenics_drill.model.discretization import U
 from fenics_drill.model.drillstring import build_model
 from fenics_drill.model.forces.protocol import ForceEvaluation
-from fenics_drill.model.spaces import weighted_product
 from fenics_drill.solvers.time_loop import Simulation
 
 
@@ -30,14 +29,14 @@ class TipSpring:
     @classmethod
     def from_scene(cls, scene, disc, space, operators):
         p = scene.beam_properties
-        return cls(space.rows([disc.end_dof(U, 1)]), p.young_modulus * p.section.area / p.length)
+        return cls(space.point_rows([disc.end_dof(U, 1)]), p.young_modulus * p.section.area / p.length)
 
     def evaluate(self, q, qd, with_tangent=False):
-        u = self.row @ q
-        return ForceEvaluation(self.row.T @ (-self.k * u), 0.5 * self.k * float(u @ u), {})
+        u = self.row.values(q)
+        return ForceEvaluation(self.row.spread(-self.k * u), 0.5 * self.k * float(u @ u), {})
 
     def tangent(self, evaluation, c_u, c_v):
-        return weighted_product(self.row, np.array([-c_u * self.k]), self.row)
+        return self.row.block(np.array([[-c_u * self.k]]))
 
     def record(self, evaluation):
         return {}

@@ -15,7 +15,6 @@ import numpy as np
 
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
-from fenics_drill.model.spaces import weighted_product
 from fenics_drill.scene import LAW_SIGN
 
 
@@ -82,8 +81,7 @@ class BitRock:
         """``bit_rock``: the scene's [bit_rock] section (or a realisation of it); ``torque_sign``: +1 for the
         consistent torque (21), -1 for the torque as printed (mu_BR -> -mu_BR, since F_BR <= 0)."""
         self.torque_sign = torque_sign
-        self.row_u = space.rows([disc.end_dof(U, 1)])  # 1 x N_red: q -> u(L)
-        self.row_tx = space.rows([disc.end_dof(THETA_X, 1)])  # 1 x N_red: q -> theta_x(L)
+        self.rows = space.point_rows([disc.end_dof(U, 1), disc.end_dof(THETA_X, 1)])  # q -> u(L), theta_x(L)
         self.limit_force, self.rate = bit_rock.limit_force, bit_rock.rate
         self.friction, self.borehole_radius = torque_sign * bit_rock.friction, borehole_radius
 
@@ -106,7 +104,7 @@ class BitRock:
         return {"bit_force": forces.force, "bit_torque": forces.torque}
 
     def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> BitForces:
-        u_dot, omega = float((self.row_u @ qd)[0]), float((self.row_tx @ qd)[0])
+        u_dot, omega = (float(value) for value in self.rows.values(qd))
         force = float(bit_rock_force(u_dot, self.limit_force, self.rate))
         torque = float(bit_rock_torque(force, omega, self.friction, self.borehole_radius))
         d_force = -self.limit_force * self.rate * np.exp(-self.rate * u_dot) if u_dot > 0 else 0.0
@@ -114,21 +112,18 @@ class BitRock:
         # T = -mu |F| R xi = mu F R xi  (F <= 0)
         d_torque_velocity = self.friction * self.borehole_radius * xi * d_force
         d_torque_spin = self.friction * force * self.borehole_radius * float(torque_regularisation_slope(omega))
-        generalised = self.row_u.T @ np.array([force]) + self.row_tx.T @ np.array([torque])
-        laws = {"bit_rock_force": self.row_u.T @ np.array([force]), "bit_rock_torque": self.row_tx.T @ np.array([torque])}
+        laws = {"bit_rock_force": self.rows.spread(np.array([force, 0.0])),
+                "bit_rock_torque": self.rows.spread(np.array([0.0, torque]))}
+        generalised = laws["bit_rock_force"] + laws["bit_rock_torque"]
         return BitForces(generalised, 0.0, laws, u_dot, omega, force, torque, d_force, d_torque_velocity,
                          d_torque_spin)
 
     def kink_step(self, forces: BitForces, dq: np.ndarray, c_v: float) -> float | None:
         """The fraction of a Newton update dq (which moves qd by c_v dq) just past u_dot_bit = 0, where
         (20) switches between no force and its steepest slope; None if the update does not cross it."""
-        return step_past_kink(forces.bit_velocity, c_v * float((self.row_u @ dq)[0]))
+        return step_past_kink(forces.bit_velocity, c_v * float(self.rows.values(dq)[0]))
 
     def tangent(self, forces: BitForces, c_u: float, c_v: float):
         """c_v d f_BR / d qd (the law depends on velocities only, so c_u plays no part)."""
-        gu, gt = self.row_u, self.row_tx
-        return (
-            weighted_product(gu, np.array([c_v * forces.d_force]), gu)
-            + weighted_product(gt, np.array([c_v * forces.d_torque_velocity]), gu)
-            + weighted_product(gt, np.array([c_v * forces.d_torque_spin]), gt)
-        )
+        return self.rows.block(c_v * np.array([[forces.d_force, 0.0],
+                                               [forces.d_torque_velocity, forces.d_torque_spin]]))

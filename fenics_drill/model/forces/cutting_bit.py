@@ -30,7 +30,6 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
-import scipy.sparse as sp
 
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
@@ -135,8 +134,7 @@ class CuttingBit:
     }
 
     def __init__(self, disc: BeamDiscretization, space, bit_rock, drive):
-        self.rows = space.rows([disc.end_dof(U, 1), disc.end_dof(THETA_X, 1)])  # 2 x N: q -> u(L), theta_x(L)
-        self.sparse = space.sparse
+        self.rows = space.point_rows([disc.end_dof(U, 1), disc.end_dof(THETA_X, 1)])  # q -> u(L), theta_x(L)
         self._set_parameters(bit_rock)
         self.feed_per_radian = drive.axial_velocity / drive.rotation_speed if drive.rotation_speed > 0 else 0.0
         self.surface: CutSurface | None = None  # no rock cut before the drilling run begins
@@ -177,7 +175,7 @@ class CuttingBit:
         return changed
 
     def _bit(self, vector: np.ndarray) -> tuple[float, float]:
-        u, phi = np.ravel(self.rows @ vector)
+        u, phi = self.rows.values(vector)
         return float(u), float(phi)
 
     def begin(self, t: float, q: np.ndarray) -> None:
@@ -219,13 +217,12 @@ class CuttingBit:
         jac_qd = -np.array([[d_contact_v, 0.0],
                             [self.contact_torque_arm * d_contact_v * s, magnitude * ds / self.spin_scale]])
         f_u, f_t = -weight, -torque
-        rows_u, rows_t = self.rows[[0]], self.rows[[1]]
-        laws = {"bit_rock_force": np.ravel(rows_u.T @ np.array([f_u])),
-                "bit_rock_torque": np.ravel(rows_t.T @ np.array([f_t]))}
+        laws = {"bit_rock_force": self.rows.spread(np.array([f_u, 0.0])),
+                "bit_rock_torque": self.rows.spread(np.array([0.0, f_t]))}
         generalised = laws["bit_rock_force"] + laws["bit_rock_torque"]
         return CuttingForces(generalised, 0.0, laws, d, f_u, f_t, jac_q, jac_qd)
 
     def tangent(self, forces: CuttingForces, c_u: float, c_v: float):
         """c_u df/dq + c_v df/dqd: the 2 x 2 law Jacobians at the bit, projected."""
         block = c_u * forces.jacobian_q + c_v * forces.jacobian_qd
-        return self.rows.T @ (sp.csr_matrix(block) @ self.rows) if self.sparse else self.rows.T @ block @ self.rows
+        return self.rows.block(block)

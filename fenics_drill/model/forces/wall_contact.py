@@ -192,6 +192,18 @@ def _weighted_rows(flat, active, blocks):
     return rows, weighted
 
 
+def _selection(rows: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
+    """(column, value) of each row of a full space's [Phi] rows, which hold one entry or none (a dof held by
+    a support: column -1, value 0)."""
+    counts = np.diff(rows.indptr)
+    if counts.max(initial=0) > 1:
+        raise ValueError("rows of the full space's [Phi] hold one entry each")
+    columns, values = np.full(rows.shape[0], -1, dtype=np.int64), np.zeros(rows.shape[0])
+    first = rows.indptr[:-1][counts == 1]
+    columns[counts == 1], values[counts == 1] = rows.indices[first], rows.data[first]
+    return columns, values
+
+
 class ProjectedLaws(Mapping):
     """The generalised forces of the non-conservative wall laws (the damper of (17), (18), (19)),
     projected on first use: the energy budget reads them at accepted steps only, not at Newton's
@@ -365,11 +377,13 @@ class WallContact:
         if active.size == 0:
             return None
         blocks = _contact_blocks(active, lateral, rates, *self._law(), c_u, c_v)
-        if sp.issparse(flat):
-            rows = (len(FIELDS) * active[:, None] + np.arange(len(FIELDS))).ravel()
-            block = flat[rows]
-            diagonal = sp.bsr_matrix((blocks, np.arange(active.size), np.arange(active.size + 1)),
-                                     shape=(rows.size, rows.size))
-            return sp.csr_matrix(block.T @ (diagonal @ block))
+        if sp.issparse(flat):  # the full space: each row of [Phi] selects one free dof (or none, at a support)
+            columns, values = _selection(flat)
+            at = len(FIELDS) * active[:, None] + np.arange(len(FIELDS))
+            dofs, scale = columns[at], values[at]
+            rows, columns = np.broadcast_arrays(dofs[:, :, None], dofs[:, None, :])
+            data = scale[:, :, None] * blocks * scale[:, None, :]
+            kept = (rows >= 0) & (columns >= 0) & (data != 0.0)
+            return sp.coo_matrix((data[kept], (rows[kept], columns[kept])), shape=(flat.shape[1],) * 2)
         rows, weighted = _weighted_rows(flat, active, blocks)
         return rows.T @ weighted
