@@ -48,7 +48,9 @@ def _band_widths(rows, columns, position, held_slot):
 @kernel
 def _band_fill(rows, columns, data, position, held_slot, kl, ku, band, held_columns, held_rows):
     """LAPACK's band storage of the renumbered matrix, identity at the held dofs, and the matrix's held
-    columns and rows (dense), in one pass over its (row, column, value) entries (repeated ones add up)."""
+    columns and rows (dense), in one pass over its (row, column, value) entries (repeated ones add up).
+    Returns the number of entries outside the bandwidths (kl, ku), which are left out."""
+    outside = 0
     for k in range(rows.size):
         row, col, value = rows[k], columns[k], data[k]
         if held_slot[col] >= 0:
@@ -56,16 +58,23 @@ def _band_fill(rows, columns, data, position, held_slot, kl, ku, band, held_colu
         if held_slot[row] >= 0:
             held_rows[held_slot[row], col] += value
         elif held_slot[col] < 0:
-            band[kl + ku + position[row] - position[col], position[col]] += value
+            d = position[row] - position[col]
+            if d > kl or -d > ku:
+                outside += 1
+            else:
+                band[kl + ku + d, position[col]] += value
     for dof in range(held_slot.size):
         if held_slot[dof] >= 0:
             band[kl + ku, position[dof]] = 1.0
+    return outside
 
 
 class BandedSaddle:
     """The factorised saddle matrix [[J, B^T], [B, 0]] of (76), J sparse, its dofs renumbered by ``order``."""
 
-    def __init__(self, tangent: sp.spmatrix, constraints, order: np.ndarray):
+    def __init__(self, tangent: sp.spmatrix, constraints, order: np.ndarray, width: int | None = None):
+        """``width``: the bandwidth the renumbered J has by construction (found from its entries if None);
+        an entry outside it is an error."""
         tangent = tangent if isinstance(tangent, sp.coo_matrix) else sp.coo_matrix(tangent)
         n = tangent.shape[0]
         self.held, self.coefficients = held_dofs(constraints)
@@ -74,11 +83,15 @@ class BandedSaddle:
         position = np.empty(n, dtype=np.int64)
         position[order] = np.arange(n)
         self.order = order
-        self.kl, self.ku = _band_widths(tangent.row, tangent.col, position, held_slot)
+        self.kl, self.ku = _band_widths(tangent.row, tangent.col, position, held_slot) if width is None \
+            else (width, width)
         band = np.zeros((n, 2 * self.kl + self.ku + 1)).T  # Fortran order, as LAPACK stores it
         self.held_columns, self.held_rows = np.zeros((n, self.held.size)), np.zeros((self.held.size, n))
-        _band_fill(tangent.row, tangent.col, tangent.data, position, held_slot, self.kl, self.ku, band,
-                   self.held_columns, self.held_rows)
+        outside = _band_fill(tangent.row, tangent.col, tangent.data, position, held_slot, self.kl, self.ku, band,
+                             self.held_columns, self.held_rows)
+        if outside:
+            raise ValueError(f"{outside} entries of the tangent lie outside its bandwidth {self.kl}: a force couples "
+                             "dofs of different elements")
         self.lu, self.pivots, info = lapack.dgbtrf(band, self.kl, self.ku, overwrite_ab=1)
         if info != 0:
             raise np.linalg.LinAlgError(f"the saddle matrix (76) is singular (LAPACK dgbtrf info = {info})")

@@ -186,6 +186,13 @@ class FullSpace:
         self._saddle = SaddleFactorisation(self._factorise)
         # the free dofs numbered along the string: an element couples only neighbours in this order
         self._band_order = np.argsort(disc.dof_coordinates[self.free], kind="stable")
+        # the tangent's bandwidth in that order: the farthest two free dofs of one element (a point force
+        # couples the dofs of one vertex, which share an element)
+        band_position = np.full(ndofs, -1, dtype=np.int64)
+        band_position[self.free[self._band_order]] = np.arange(self.free.size)
+        cells = band_position[disc.V.dofmap.list]
+        spread = np.where(cells >= 0, cells, -1).max(axis=1) - np.where(cells >= 0, cells, ndofs).min(axis=1)
+        self._band_width = int(spread.max())
         self.phi = sp.csr_matrix(
             (np.ones(self.free.size), (self.free, np.arange(self.free.size))), shape=(ndofs, self.free.size)
         )
@@ -234,7 +241,7 @@ class FullSpace:
         return sp.coo_matrix((data, (rows, columns)), shape=(self.size, self.size))
 
     def _factorise(self, tangent, constraints) -> BandedSaddle:
-        return BandedSaddle(tangent, constraints, self._band_order)
+        return BandedSaddle(tangent, constraints, self._band_order, self._band_width)
 
     def saddle_solve(self, tangent, constraints, rhs_q: np.ndarray, rhs_c: np.ndarray):
         """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76), with a banded LU and the held dofs

@@ -57,6 +57,17 @@ def test_a_constraint_on_two_dofs_is_refused():
         BandedSaddle(coo, B, order)
 
 
+def test_an_entry_outside_the_given_bandwidth_is_refused():
+    """The full space gives the bandwidth of one element; an entry beyond it would be left out of the
+    factorisation, so it must stop the solve instead."""
+    dense, coo, order = scrambled_band(20, 2, 0)
+    B = np.zeros((1, 20))
+    B[0, order[0]] = 1.0
+    BandedSaddle(coo, B, order, width=2)  # the band's own width holds every entry
+    with pytest.raises(ValueError, match="outside its bandwidth 1"):
+        BandedSaddle(coo, B, order, width=1)
+
+
 def test_a_singular_tangent_is_reported():
     n = 12
     J = sp.coo_matrix(np.diag(np.r_[np.ones(n - 1), 0.0]))
