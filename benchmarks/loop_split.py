@@ -1,6 +1,6 @@
 """Where a run's time goes, without a profiler: the time loop's parts timed around their calls.
 
-    python benchmarks/loop_split.py T_END
+    python benchmarks/loop_split.py T_END [SECTION.KEY=VALUE ...]
 
 Runs the paper scene for T_END seconds (no field output) and prints the total, the time loop (the
 ECSW training run included) and, inside it, the Newton steps, the per-step recording (time series,
@@ -61,7 +61,8 @@ def main() -> None:
             SPENT["time loop"] += time.perf_counter() - clock
 
     time_loop.Simulation.run = timed_run
-    scene = load_scene("demos/scenes/paper.toml", [f"time.t_end={sys.argv[1]}", "output.field_interval=0"])
+    scene = load_scene("demos/scenes/paper.toml", [f"time.t_end={sys.argv[1]}", "output.field_interval=0",
+                                                   *sys.argv[2:]])
     with tempfile.TemporaryDirectory() as out:
         clock = time.perf_counter()
         summary = run_scene(scene, out, progress=False, overwrite=True)
