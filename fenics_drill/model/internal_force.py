@@ -15,6 +15,7 @@ so a change of step size needs no re-assembly.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import dolfinx.fem.petsc as fem_petsc
@@ -67,6 +68,70 @@ class ElementSample:
     weights: np.ndarray
 
 
+class InternalForms:
+    """The UFL forms of the internal force of one string: the residual of (43), its derivatives by the
+    displacement, velocity and acceleration fields, and the kinetic and strain energies, on all elements
+    or on an element sample (weighted, the nonlinear remainder only).
+
+    Compiling them costs about 0.5 s, and the whole string's forms do not depend on the solution space:
+    :meth:`of` builds them once per string and switches, and the models of a string (reduced, enriched,
+    full order) share them and their functions U, V, A."""
+
+    def __init__(self, disc: BeamDiscretization, switches: tuple, sample: ElementSample | None):
+        geometric_nonlinearity, inertial_nonlinearity, kinematics, angular_velocity = switches
+        p = disc.properties
+        # Energies are polynomials of degree <= 4 in the fields up to sin/cos(theta_x):
+        # 2k integrates the mass exactly for v, w of degree k and keeps the kernels small.
+        metadata = {"quadrature_degree": 2 * disc.element_degree}
+        self.functions = U, V, A = tuple(fem.Function(disc.V) for _ in range(3))
+        psi, dU = ufl.TestFunction(disc.V), ufl.TrialFunction(disc.V)
+        if sample is None:
+            dx, weight, self.dofs = ufl.Measure("dx", domain=disc.mesh, metadata=metadata), 1.0, None
+        else:
+            cells = np.asarray(sample.cells, dtype=np.int32)
+            tags = meshtags(disc.mesh, disc.mesh.topology.dim, cells, np.ones_like(cells))
+            dx = ufl.Measure("dx", domain=disc.mesh, subdomain_data=tags, metadata=metadata)(1)
+            weight = fem.Function(fem.functionspace(disc.mesh, ("DG", 0)))
+            weight.x.array[cells] = sample.weights
+            self.weight = weight
+            self.dofs = np.unique(disc.V.dofmap.list[cells]).astype(PETSc.IntType)
+
+        def forces(geometric, inertial):
+            return (energies.inertial_force(p, psi, U, V, A, dx, inertial, angular_velocity, weight)
+                    + energies.elastic_force(p, psi, U, dx, geometric, kinematics, weight))
+
+        def energy(density, linear_density):
+            return weight * (density - linear_density if sample is not None else density) * dx
+
+        residual = forces(geometric_nonlinearity, inertial_nonlinearity)
+        kinetic = energies.kinetic_energy_density(p, U, V, inertial_nonlinearity, angular_velocity)
+        strain = energies.strain_energy_density(p, energies.strain_slots(U), geometric_nonlinearity, kinematics)
+        if sample is None:
+            residual = residual + energies.damping_force(p, psi, V, dx)
+        else:  # the nonlinear remainder; the linear part is applied with projected matrices
+            residual = residual - forces(False, False)
+        self.kinetic = fem.form(energy(kinetic, energies.kinetic_energy_density(p, U, V, False)))
+        self.strain = fem.form(energy(strain, energies.strain_energy_density(p, energies.strain_slots(U), False)))
+        self.residual = fem.form(residual)
+        # one form per derivative df/dq, df/dqd, df/dqdd (None where f does not depend on it): each part is
+        # assembled by a kernel of its own, not by the whole Jacobian's kernel with two coefficients zero
+        self.jacobians = tuple(_nonzero_form(ufl.derivative(residual, field, dU)) for field in (U, V, A))
+
+    @classmethod
+    def of(cls, disc: BeamDiscretization, switches: tuple, sample: ElementSample | None) -> "InternalForms":
+        """The forms of a string: shared for the whole string, built afresh for an element sample."""
+        if sample is not None:
+            return cls(disc, switches, sample)
+        built = _WHOLE_STRING.setdefault(disc, {})
+        if switches not in built:
+            built[switches] = cls(disc, switches, None)
+        return built[switches]
+
+
+#: The whole-string forms of each string (discretization) alive, by their switches.
+_WHOLE_STRING: "weakref.WeakKeyDictionary[BeamDiscretization, dict]" = weakref.WeakKeyDictionary()
+
+
 class AssembledInternalForce:
     """Inertial (24), damping (38) and elastic (30) forces assembled from their energies.
 
@@ -81,60 +146,28 @@ class AssembledInternalForce:
                  angular_velocity: str = "consistent", sample: ElementSample | None = None):
         self.space, self.sample = space, sample
         self.switches = (geometric_nonlinearity, inertial_nonlinearity, kinematics, angular_velocity)
-        p = disc.properties
-        # Energies are polynomials of degree <= 4 in the fields up to sin/cos(theta_x):
-        # 2k integrates the mass exactly for v, w of degree k and keeps the kernels small.
-        metadata = {"quadrature_degree": 2 * disc.element_degree}
-        self.U, self.V, self.A = (fem.Function(disc.V) for _ in range(3))
-        psi, dU = ufl.TestFunction(disc.V), ufl.TrialFunction(disc.V)
-        if sample is None:
-            dx, weight, self.dofs = ufl.Measure("dx", domain=disc.mesh, metadata=metadata), 1.0, None
-        else:
-            cells = np.asarray(sample.cells, dtype=np.int32)
-            tags = meshtags(disc.mesh, disc.mesh.topology.dim, cells, np.ones_like(cells))
-            dx = ufl.Measure("dx", domain=disc.mesh, subdomain_data=tags, metadata=metadata)(1)
-            weight = fem.Function(fem.functionspace(disc.mesh, ("DG", 0)))
-            weight.x.array[cells] = sample.weights
-            self.weight = weight
-            self.dofs = np.unique(disc.V.dofmap.list[cells]).astype(PETSc.IntType)
-            self.phi_rows = space.phi[self.dofs]
-            self._sampled_dofs = PETSc.IS().createGeneral(self.dofs)  # the sampled cells touch these dofs only
-
-        def forces(geometric, inertial):
-            return (energies.inertial_force(p, psi, self.U, self.V, self.A, dx, inertial, angular_velocity, weight)
-                    + energies.elastic_force(p, psi, self.U, dx, geometric, kinematics, weight))
-
-        def energy(density, linear_density):
-            return weight * (density - linear_density if sample is not None else density) * dx
-
-        residual = forces(geometric_nonlinearity, inertial_nonlinearity)
-        kinetic = energies.kinetic_energy_density(p, self.U, self.V, inertial_nonlinearity, angular_velocity)
-        strain = energies.strain_energy_density(p, energies.strain_slots(self.U), geometric_nonlinearity, kinematics)
-        if sample is None:
-            residual = residual + energies.damping_force(p, psi, self.V, dx)
-        else:  # the nonlinear remainder; the linear part is applied with the projected matrices below
-            residual = residual - forces(False, False)
+        forms = InternalForms.of(disc, self.switches, sample)
+        self.U, self.V, self.A = forms.functions
+        self._kinetic, self._strain, self._residual, self._jacobians = (forms.kinetic, forms.strain, forms.residual,
+                                                                       forms.jacobians)
+        self.dofs = forms.dofs
+        self._vector = fem_petsc.create_vector(self._residual.function_spaces)
+        if sample is None:  # DOLFINx's own CSR matrices, read at the entries that matter
+            self._matrices = tuple(TangentEntries(form, space, forms.functions) if form is not None
+                                   else None for form in self._jacobians)
+        else:  # the nonlinear remainder; the linear part is applied with the projected matrices
             self.linear = tuple(space.project_matrix(m) for m in (operators.stiffness, operators.damping,
                                                                    operators.mass))
-        self._kinetic = fem.form(energy(kinetic, energies.kinetic_energy_density(p, self.U, self.V, False)))
-        self._strain = fem.form(energy(strain, energies.strain_energy_density(p, energies.strain_slots(self.U),
-                                                                              False)))
-        self._residual = fem.form(residual)
-        self._vector = fem_petsc.create_vector(self._residual.function_spaces)
-        # one form per derivative df/dq, df/dqd, df/dqdd (None where f does not depend on it): each part is
-        # assembled by a kernel of its own, not by the whole Jacobian's kernel with two coefficients zero
-        self._jacobians = tuple(_nonzero_form(ufl.derivative(residual, field, dU))
-                                for field in (self.U, self.V, self.A))
-        if sample is None:  # DOLFINx's own CSR matrices, read at the entries that matter
-            self._matrices = tuple(TangentEntries(form, space, (self.U, self.V, self.A)) if form is not None
-                                   else None for form in self._jacobians)
-        else:
+            self.weight, self.phi_rows = forms.weight, space.phi[self.dofs]  # the sample's weight per cell
+            self._sampled_dofs = PETSc.IS().createGeneral(self.dofs)  # the sampled cells touch these dofs only
             self._matrices = tuple(fem_petsc.create_matrix(form) if form is not None else None
                                    for form in self._jacobians)
         self._damping = space.project_matrix(operators.damping)  # (45) is linear: reused for the budget
-        self._packing = SampledCoefficients(self._residual, (self.U, self.V, self.A), self.dofs, self.phi_rows) \
+        self._packing = SampledCoefficients(self._residual, forms.functions, self.dofs, self.phi_rows) \
             if sample is not None else None
-        self._state = None  # (q, qd, qdd) of the last evaluation, set on the functions when a tangent needs it
+        # (q, qd, qdd) of the last evaluation, set on the functions when a tangent needs it (other forces on
+        # the same string share the functions, so a tangent never assumes they still hold this state)
+        self._state = None
 
     def _set(self, function: fem.Function, values: np.ndarray) -> None:
         if self.dofs is None:
@@ -154,9 +187,9 @@ class AssembledInternalForce:
         return self._vector.array
 
     def evaluate(self, q, qd, qdd) -> np.ndarray:
+        self._state = (q, qd, qdd)
         if self.dofs is None:
             return self.space.project(self.assembled_vector(q, qd, qdd))
-        self._state = (q, qd, qdd)
         K, C, M = self.linear
         return K @ q + C @ qd + M @ qdd + self.phi_rows.T @ self._packing.assemble(q, qd, qdd)
 
@@ -167,10 +200,6 @@ class AssembledInternalForce:
         linear = self.linear[k] if self.dofs is not None else None
         if self._jacobians[k] is None:
             return linear if linear is not None else self.space.zeros_matrix()
-        if self._state is not None:  # a sampled evaluation packs its coefficients without the functions
-            for function, values in zip((self.U, self.V, self.A), self._state):
-                self._set(function, values)
-            self._state = None
         matrix = self._matrices[k]
         if self.dofs is None:
             return matrix.assemble()
@@ -183,6 +212,9 @@ class AssembledInternalForce:
     def tangent_parts(self, needed=(True, True, True)):
         """(df/dq, df/dqd, df/dqdd) at the state of the last :meth:`evaluate`; None for a part not
         ``needed`` (a static solve needs df/dq only: one assembly instead of three)."""
+        if self._state is not None:  # a sampled evaluation packs its coefficients without the functions, and
+            for function, values in zip((self.U, self.V, self.A), self._state):  # other models share them
+                self._set(function, values)
         return tuple(self._part(k) if want else None for k, want in enumerate(needed))
 
     def kinetic_energy(self, q, qd) -> float:
