@@ -21,7 +21,9 @@ def test_models_of_one_string_share_forms_without_sharing_states():
     alone = reduced.internal.tangent_parts()
     full.internal.evaluate(*state(full, 1e-1))  # sets the shared functions to another state
     again = reduced.internal.tangent_parts()
-    # the same assembly of the same state: equal to round-off, not merely close
+    # the same kernels at the same state: equal up to round-off (~1e-16 of the entries; the functions are
+    # set again from q by a product with [Phi], so not bit for bit). The other model's state is 10x larger
+    # and random: had it leaked in, the parts would differ at order one
     for a, b in zip(alone, again):
         assert np.allclose(a, b, rtol=1e-12, atol=1e-12 * np.abs(a).max())
     assert np.allclose(reduced.internal.evaluate(*x), force, rtol=1e-12, atol=1e-12 * np.abs(force).max())

@@ -23,7 +23,9 @@ def test_point_rows_are_the_rows_of_phi(rule):
     x, f, jacobian = rng.standard_normal(space.size), rng.standard_normal(4), rng.standard_normal((4, 4))
     block = rows.block(jacobian)
     block = block.toarray() if hasattr(block, "toarray") else block
-    # the same sums in another order: round-off of the dense products only
+    # the same products computed two ways: in the full space a gather/scatter of entries that are 1 or 0
+    # (exact), in a modal one the same BLAS products (at most 59 terms of O(1) each, so a few 1e-16 of
+    # round-off); 1e-13 of the operands' size is far above that and far below any wrong row or sign
     assert np.allclose(rows.values(x), expected @ x, rtol=1e-13, atol=1e-13 * np.abs(x).max())
     assert np.allclose(rows.spread(f), expected.T @ f, rtol=1e-13, atol=1e-13)
     assert np.allclose(block, expected.T @ jacobian @ expected, rtol=1e-13, atol=1e-13 * np.abs(jacobian).max())

@@ -40,7 +40,9 @@ def solve(with_kink: bool):
 
 def test_the_line_search_tries_the_step_just_past_a_kink_and_then_converges_on_the_new_branch():
     (root, updates), evaluations = solve(with_kink=True)
-    assert root == pytest.approx(LOAD / (1 + STIFF), rel=1e-12)  # the residual's own tolerance
+    # Newton stops at |r| <= 1e-12 b; on the stiff branch r' = 1 + K, so |y - y*| <= 1e-12 b / (1 + K),
+    # i.e. 1e-12 of y* = b / (1 + K): the tolerance is the residual's own
+    assert root == pytest.approx(LOAD / (1 + STIFF), rel=1e-12)
     # from y = -1 the unit spring's update overshoots to y = b, the kink trial lands just past y = 0, and
     # the next update on the stiff branch (linear) is exact: converged at the third check, after three trials
     assert updates == 3 and evaluations == 3
@@ -54,6 +56,8 @@ def test_the_kink_step_lands_just_past_zero_on_the_far_side(value, change):
     s = step_past_kink(value, change)
     landed = value + s * change
     assert np.sign(landed) == np.sign(value + change)
+    # landed = -KINK_PAST value exactly in real arithmetic; value + s change cancels to 1e-6 of value, so
+    # the round-off of that sum (1e-16 of value) is 1e-10 of the result: 1e-9 holds it with margin
     assert abs(landed) == pytest.approx(KINK_PAST * abs(value), rel=1e-9)
 
 
