@@ -26,9 +26,17 @@ def interrupt_in(error: BaseException) -> KeyboardInterrupt | None:
     return None
 
 
-def kernel(function):
-    """``function`` compiled by Numba (nopython, cached), called so that an interrupt is not a failure."""
-    compiled = njit(cache=True)(function)
+#: Numba's fastmath flags for kernels that sum long products: reassociated (vectorised) sums and fused
+#: multiply-adds, which change results by round-off only; NaN and infinity keep their meaning.
+REASSOCIATE = frozenset({"reassoc", "contract"})
+
+
+def kernel(function=None, *, fastmath=False):
+    """``function`` compiled by Numba (nopython, cached), called so that an interrupt is not a failure;
+    ``fastmath``: Numba's flags (e.g. :data:`REASSOCIATE`)."""
+    if function is None:
+        return functools.partial(kernel, fastmath=fastmath)
+    compiled = njit(cache=True, fastmath=set(fastmath) if fastmath else False)(function)
 
     @functools.wraps(function)
     def call(*args):

@@ -27,6 +27,7 @@ from dolfinx.mesh import meshtags
 from petsc4py import PETSc
 
 from fenics_drill.forms import energies
+from fenics_drill.model.cell_kernels import CellAssembly
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.operators import LinearOperators, petsc_to_scipy
 
@@ -158,6 +159,7 @@ class AssembledInternalForce:
         else:  # the nonlinear remainder; the linear part is applied with the projected matrices
             self.linear = tuple(space.project_matrix(m) for m in (operators.stiffness, operators.damping,
                                                                    operators.mass))
+            self._linear_rows = np.hstack(self.linear)  # [K C M]: the linear part of (q, qd, qdd) stacked
             self.weight, self.phi_rows = forms.weight, space.phi[self.dofs]  # the sample's weight per cell
             self._sampled_dofs = PETSc.IS().createGeneral(self.dofs)  # the sampled cells touch these dofs only
             self._matrices = tuple(fem_petsc.create_matrix(form) if form is not None else None
@@ -190,8 +192,8 @@ class AssembledInternalForce:
         self._state = (q, qd, qdd)
         if self.dofs is None:
             return self.space.project(self.assembled_vector(q, qd, qdd))
-        K, C, M = self.linear
-        return K @ q + C @ qd + M @ qdd + self.phi_rows.T @ self._packing.assemble(q, qd, qdd)
+        state = np.concatenate((q, qd, qdd))
+        return self._linear_rows @ state + self.phi_rows.T @ self._packing.assemble(state)
 
     state_dependent = True
 
@@ -237,32 +239,27 @@ class SampledCoefficients:
 
     The packed coefficients of the cells (what ``dolfinx.fem.pack_coefficients`` gives: the weight and
     the dofs of U, V, A on each cell) are an affine function of the reduced state, found once by packing
-    the columns of [Phi]; an evaluation is then one small product and DOLFINx's assembly with prepacked
-    coefficients, without setting the functions or DOLFINx's Python packing path."""
+    the columns of [Phi]; an evaluation is then one small product and the cells' kernels
+    (:class:`~fenics_drill.model.cell_kernels.CellAssembly`), without setting the functions or DOLFINx's
+    packing and assembly paths."""
 
     def __init__(self, form: fem.Form, functions, dofs: np.ndarray, phi_rows: np.ndarray):
-        self.form, self.dofs = form, dofs
-        self.constants = fem.pack_constants(form)
         for function in functions:
             function.x.array[:] = 0.0
-        (self.key, packed), = fem.pack_coefficients(form).items()
+        (key, packed), = fem.pack_coefficients(form).items()
         self.shape, self.offset = packed.shape, packed.ravel().copy()
         columns = []
         for function in functions:
             for column in phi_rows.T:
                 function.x.array[dofs] = column
-                columns.append(fem.pack_coefficients(form)[self.key].ravel() - self.offset)
+                columns.append(fem.pack_coefficients(form)[key].ravel() - self.offset)
             function.x.array[:] = 0.0
         self.map = np.ascontiguousarray(np.column_stack(columns))
-        self.vector = np.zeros(form.function_spaces[0].dofmap.index_map.size_local
-                               * form.function_spaces[0].dofmap.index_map_bs)
+        self.cells = CellAssembly(form, dofs)
 
-    def assemble(self, *state: np.ndarray) -> np.ndarray:
-        """The assembled vector at the sampled dofs at the reduced state (q, qd, qdd)."""
-        packed = (self.offset + self.map @ np.concatenate(state)).reshape(self.shape)
-        self.vector[:] = 0.0
-        fem.assemble_vector(self.vector, self.form, self.constants, {self.key: packed})
-        return self.vector[self.dofs]
+    def assemble(self, state: np.ndarray) -> np.ndarray:
+        """The assembled vector at the sampled dofs at the reduced state (q, qd, qdd) stacked in one vector."""
+        return self.cells((self.offset + self.map @ state).reshape(self.shape))
 
 
 class TangentEntries:

@@ -19,7 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from fenics_drill.model.compiled import kernel
+from fenics_drill.model.compiled import REASSOCIATE, kernel
 from fenics_drill.model.discretization import THETA_X as TX_FIELD
 from fenics_drill.model.discretization import U as U_FIELD
 from fenics_drill.model.discretization import V as V_FIELD
@@ -104,32 +104,69 @@ def wall_friction(normal_force, axial_velocity, spin_rate, friction, borehole_ra
 _FRICTION = np.vectorize(_friction, otypes=(float, float))
 
 
+@njit(cache=True)
+def _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s, delta, nodal,
+                laws):
+    """Eqs. (16)-(19) at vertex i with lateral position (v, w) and rates (u, v, w, theta_x)_dot: its
+    indentation, nodal loads and the loads of each law; returns the springs' energy."""
+    r = np.hypot(v, w)
+    d = r - gap
+    delta[i] = d
+    if d <= 0.0:
+        return 0.0
+    n_v, n_w = v / r, w / r
+    normal = _normal_force(d, n_v * rates[1] + n_w * rates[2], k1, k2, damping, printed)
+    axial, torque = _friction(normal, rates[0], rates[3], mu_axial, mu_torque, radius_bh, v_s)
+    nodal[i, 0], nodal[i, 1], nodal[i, 2], nodal[i, 3] = axial, normal * n_v, normal * n_w, torque
+    damper = normal + k1 * d + k2 * d**3  # with the clip that keeps the wall from pulling
+    laws[i, 1, 0], laws[i, 2, 0] = damper * n_v, damper * n_w
+    laws[i, 0, 1] = axial
+    laws[i, 3, 2] = torque
+    return 0.5 * k1 * d**2 + 0.25 * k2 * d**4
+
+
 @kernel
 def _vertex_loads(lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s):
     """Eqs. (16)-(19) at every vertex: indentation, nodal loads (F_a, F_v, F_w, T), the loads of the
     damper, the axial friction and the friction torque (vertex, field, law), and the springs' energy."""
     n = lateral.shape[0]
-    delta = np.empty(n)
-    nodal = np.zeros((n, 4))
-    laws = np.zeros((n, 4, 3))
+    delta, nodal, laws = np.empty(n), np.zeros((n, 4)), np.zeros((n, 4, 3))
     potential = 0.0
     for i in range(n):
-        v, w = lateral[i, 0], lateral[i, 1]
-        r = np.hypot(v, w)
-        d = r - gap
-        delta[i] = d
-        if d <= 0.0:
-            continue
-        n_v, n_w = v / r, w / r
-        normal = _normal_force(d, n_v * rates[i, 1] + n_w * rates[i, 2], k1, k2, damping, printed)
-        axial, torque = _friction(normal, rates[i, 0], rates[i, 3], mu_axial, mu_torque, radius_bh, v_s)
-        nodal[i, 0], nodal[i, 1], nodal[i, 2], nodal[i, 3] = axial, normal * n_v, normal * n_w, torque
-        damper = normal + k1 * d + k2 * d**3  # with the clip that keeps the wall from pulling
-        laws[i, 1, 0], laws[i, 2, 0] = damper * n_v, damper * n_w
-        laws[i, 0, 1] = axial
-        laws[i, 3, 2] = torque
-        potential += 0.5 * k1 * d**2 + 0.25 * k2 * d**4
+        potential += _vertex_law(i, lateral[i, 0], lateral[i, 1], rates[i], gap, k1, k2, damping, printed,
+                                 mu_axial, mu_torque, radius_bh, v_s, delta, nodal, laws)
     return delta, nodal, laws, potential
+
+
+@kernel(fastmath=REASSOCIATE)
+def _modal_pass(flat, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s):
+    """:func:`_vertex_loads` in a modal space, in one pass over the dense rows ``flat`` of [Phi]
+    ((u, v, w, theta_x) of each vertex, interleaved): each vertex's positions and rates, its law, and
+    [Phi]^T of its nodal loads, while its four rows are in cache.  Also returns the positions and rates."""
+    n, size = flat.shape[0] // 4, flat.shape[1]
+    delta, nodal, laws = np.empty(n), np.zeros((n, 4)), np.zeros((n, 4, 3))
+    lateral, rates, generalised = np.empty((n, 2)), np.empty((n, 4)), np.zeros(size)
+    potential = 0.0
+    for i in range(n):
+        base = 4 * i
+        v = w = r0 = r1 = r2 = r3 = 0.0
+        for j in range(size):
+            v += flat[base + 1, j] * q[j]
+            w += flat[base + 2, j] * q[j]
+            r0 += flat[base, j] * qd[j]
+            r1 += flat[base + 1, j] * qd[j]
+            r2 += flat[base + 2, j] * qd[j]
+            r3 += flat[base + 3, j] * qd[j]
+        lateral[i, 0], lateral[i, 1] = v, w
+        rates[i, 0], rates[i, 1], rates[i, 2], rates[i, 3] = r0, r1, r2, r3
+        potential += _vertex_law(i, v, w, rates[i], gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh,
+                                 v_s, delta, nodal, laws)
+        if delta[i] > 0.0:
+            for f in range(4):
+                load = nodal[i, f]
+                for j in range(size):
+                    generalised[j] += flat[base + f, j] * load
+    return delta, nodal, laws, potential, generalised, lateral, rates
 
 
 @kernel
@@ -354,13 +391,18 @@ class WallContact:
         compiled over the vertices that can reach the wall, and the law-by-law split is projected only
         when read.  The indentation is -inf at the vertices left out."""
         vertex_set = self._near_vertices(q) if self.culling else self.every
-        lateral = (vertex_set.lateral_rows @ q).reshape(-1, 2)
-        rates = (vertex_set.flat @ qd).reshape(-1, len(FIELDS))
-        delta, nodal, laws, potential = _vertex_loads(lateral, rates, *self._law())
+        if sp.issparse(vertex_set.flat):  # the full space: the rows select dofs
+            lateral = (vertex_set.lateral_rows @ q).reshape(-1, 2)
+            rates = (vertex_set.flat @ qd).reshape(-1, len(FIELDS))
+            delta, nodal, laws, potential = _vertex_loads(lateral, rates, *self._law())
+            generalised = np.asarray(vertex_set.flat.T @ nodal.ravel())
+        else:
+            delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(vertex_set.flat, q, qd,
+                                                                                     *self._law())
         active = np.flatnonzero(delta > 0)
         indentation = np.full(len(self.x), -np.inf)
         indentation[vertex_set.vertices] = delta
-        out = WallForces(np.asarray(vertex_set.flat.T @ nodal.ravel()), potential,
+        out = WallForces(generalised, potential,
                          ProjectedLaws(vertex_set.flat, laws), indentation, indentation > 0,
                          -np.hypot(nodal[active, 1], nodal[active, 2]), nodal[active, 0], nodal[active, 3])
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it

@@ -1,0 +1,80 @@
+"""FFCx's element kernels called from Numba on a few cells: a form assembled on an element sample without
+DOLFINx's assembler.
+
+A sampled internal force (:mod:`fenics_drill.model.hyper_reduction`) lives on a handful of elements, and
+at every Newton iterate DOLFINx's ``assemble_vector`` spent about ten times longer in its set-up than in
+the kernels of those cells (benchmarks/RESULTS.md, issue 17).  :class:`CellAssembly` calls the form's
+generated ``tabulate_tensor`` directly, cell after cell, and adds each element vector at its dofs.  The
+kernel is called through its address, so the compiled loop is cached on disk like every other kernel.
+"""
+
+from __future__ import annotations
+
+import cffi
+import numpy as np
+from dolfinx import fem
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic
+
+from fenics_drill.model.compiled import kernel
+
+_FFI = cffi.FFI()
+
+
+@intrinsic
+def _call_at(typingctx, address, element, coefficients, constants, coordinates, entity, permutation, data):
+    """Call the C function at ``address`` with the seven pointers of a ufcx ``tabulate_tensor``."""
+    signature = types.void(address, element, coefficients, constants, coordinates, entity, permutation, data)
+
+    def codegen(context, builder, sig, args):
+        function = ir.FunctionType(ir.VoidType(), [context.get_value_type(t) for t in sig.args[1:]])
+        builder.call(builder.inttoptr(args[0], function.as_pointer()), args[1:])
+        return context.get_dummy_value()
+
+    return signature, codegen
+
+
+@kernel
+def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, size):
+    """sum over the cells of their element vectors, at the positions ``cell_dofs`` of a vector of ``size``."""
+    out = np.zeros(size)
+    element = np.empty(cell_dofs.shape[1])
+    entity, permutation = np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
+    for c in range(cell_dofs.shape[0]):
+        element[:] = 0.0
+        _call_at(address, _FFI.from_buffer(element), _FFI.from_buffer(coefficients[c]), _FFI.from_buffer(constants),
+                 _FFI.from_buffer(coordinates[c]), _FFI.from_buffer(entity), _FFI.from_buffer(permutation),
+                 _FFI.from_buffer(permutation))
+        for k in range(cell_dofs.shape[1]):
+            out[cell_dofs[c, k]] += element[k]
+    return out
+
+
+class CellAssembly:
+    """A linear form with one cell integral, assembled at the dofs ``dofs`` from packed coefficients."""
+
+    def __init__(self, form: fem.Form, dofs: np.ndarray):
+        cell = fem.IntegralType.cell
+        if form.rank != 1 or set(form.integral_types) != {cell} or form.num_integrals(cell, 0) != 1:
+            raise ValueError("CellAssembly takes a linear form with exactly one cell integral")
+        integral = form.ufcx_form.form_integrals[0]
+        self.address = int(_FFI.cast("uintptr_t", integral.tabulate_tensor_float64))
+        cells = form._cpp_object.domains(cell, 0)  # in the order of the packed coefficients
+        mesh = form.mesh
+        self.coordinates = np.ascontiguousarray(mesh.geometry.x[mesh.geometry.dofmaps[0][cells]].reshape(len(cells), -1))
+        space = form.function_spaces[0]
+        if space.dofmap.bs != 1:
+            raise ValueError("CellAssembly takes a space of block size 1")
+        position = np.full(space.dofmap.index_map.size_local + space.dofmap.index_map.num_ghosts, -1, dtype=np.int64)
+        position[dofs] = np.arange(len(dofs))
+        self.cell_dofs = np.ascontiguousarray(position[space.dofmap.map()[cells]])
+        if (self.cell_dofs < 0).any():
+            raise ValueError("the sampled cells touch dofs outside the given ones")
+        self.constants = np.ascontiguousarray(fem.pack_constants(form), dtype=float)
+        self.size = len(dofs)
+
+    def __call__(self, coefficients: np.ndarray) -> np.ndarray:
+        """The assembled vector at the dofs, from the cells' packed coefficients (cells x per cell)."""
+        return _assemble_cells(self.address, coefficients, self.constants, self.coordinates, self.cell_dofs,
+                               self.size)

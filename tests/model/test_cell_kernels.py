@@ -1,0 +1,84 @@
+"""FFCx's element kernels called from Numba on an element sample (fenics_drill/model/cell_kernels.py), and
+the wall law in one pass over a modal space's rows (fenics_drill/model/forces/wall_contact.py)."""
+
+import numpy as np
+import pytest
+from conftest import scene_with
+from dolfinx import fem
+
+from fenics_drill.model.cell_kernels import CellAssembly
+from fenics_drill.model.discretization import BeamDiscretization
+from fenics_drill.model.forces.wall_contact import _modal_pass, _vertex_loads
+from fenics_drill.model.internal_force import ElementSample, InternalForms
+from fenics_drill.solvers.static import solve_static
+from fenics_drill.studies.prepare import prepare
+
+STRING = ("beam.length=20.0", "beam.elements=40", "output.field_interval=0")
+
+
+@pytest.fixture(scope="module")
+def sampled_forms():
+    scene = scene_with(*STRING)
+    disc = BeamDiscretization.from_scene(scene)
+    m = scene.model
+    # unsorted cells with unequal weights: the assembly must follow the form's own order of the cells
+    sample = ElementSample(np.array([31, 2, 17, 9]), np.array([0.7, 1.9, 1.1, 2.5]))
+    return disc, InternalForms(disc, (m.geometric_nonlinearity, m.inertial_nonlinearity, m.kinematics,
+                                      m.angular_velocity), sample)
+
+
+def test_the_cells_kernels_give_dolfinx_assembly_of_the_sampled_force(sampled_forms):
+    """At three random states of the fields (displacements, rates and rotations of 0.3 in SI units, so every
+    polynomial and sine of the energies is active), the vector of the sampled cells' kernels equals DOLFINx's
+    assemble_vector at the sampled dofs.  Both add the same element vectors of the same kernel, only in
+    another order: they agree to round-off (1e-13 of the largest entry)."""
+    disc, forms = sampled_forms
+    rng = np.random.default_rng(7)
+    assembly = CellAssembly(forms.residual, forms.dofs)
+    (key, _), = fem.pack_coefficients(forms.residual).items()
+    for _ in range(3):
+        for function in forms.functions:
+            function.x.array[:] = 0.3 * rng.standard_normal(function.x.array.size)
+        packed = fem.pack_coefficients(forms.residual)[key]
+        reference = fem.assemble_vector(forms.residual).array
+        ours = assembly(packed)
+        assert np.abs(reference).max() > 0
+        np.testing.assert_allclose(ours, reference[forms.dofs], rtol=0, atol=1e-13 * np.abs(reference).max())
+        # the sampled cells touch no other dof
+        assert np.abs(np.delete(reference, forms.dofs)).max() == 0.0
+
+
+def test_cell_assembly_refuses_a_bilinear_form(sampled_forms):
+    disc, forms = sampled_forms
+    with pytest.raises(ValueError, match="linear form"):
+        CellAssembly(forms.jacobians[0], forms.dofs)
+
+
+def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
+    """In the default (modal) space, at 20 random states that put vertices against the wall, the one-pass
+    kernel gives the indentations, loads and energy of the pointwise law (16)-(19) at the positions and rates
+    [Phi] q, [Phi] qd, and [Phi]^T of the loads.  It sums in another order (reassociated, vectorised), so
+    the generalised force agrees to round-off of the sum of the magnitudes it adds (1e-12 of it)."""
+    scene = scene_with(*STRING)
+    model = prepare(scene, dynamics=False).model
+    resting = solve_static(model).q  # on the wall near the bit
+    wall = model.force("wall")
+    flat, lateral_rows = wall.every.flat, wall.every.lateral_rows
+    rng = np.random.default_rng(11)
+    touched = 0
+    for _ in range(20):
+        q = resting * (1 + 0.05 * rng.standard_normal(model.size))
+        qd = rng.standard_normal(model.size) * 0.5
+        delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(flat, q, qd, *wall._law())
+        ref_lateral, ref_rates = (lateral_rows @ q).reshape(-1, 2), (flat @ qd).reshape(-1, 4)
+        ref_delta, ref_nodal, ref_laws, ref_potential = _vertex_loads(ref_lateral, ref_rates, *wall._law())
+        np.testing.assert_allclose(lateral, ref_lateral, rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(rates, ref_rates, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(delta, ref_delta, rtol=1e-9, atol=1e-14)
+        np.testing.assert_allclose(nodal, ref_nodal, rtol=1e-6, atol=1e-9 * np.abs(ref_nodal).max())
+        np.testing.assert_allclose(laws, ref_laws, rtol=1e-6, atol=1e-9 * np.abs(ref_laws).max(initial=1.0))
+        assert potential == pytest.approx(ref_potential, rel=1e-6)
+        magnitude = np.abs(flat).T @ np.abs(ref_nodal.ravel())
+        assert np.all(np.abs(generalised - flat.T @ ref_nodal.ravel()) <= 1e-12 * magnitude.max())
+        touched += int((ref_delta > 0).sum())
+    assert touched > 20  # the states reach the wall, so the loads are tested
