@@ -1,11 +1,12 @@
-"""FFCx's element kernels called from Numba on a few cells: a form assembled on an element sample without
-DOLFINx's assembler.
+"""FFCx's element kernels called from Numba: a form assembled on an element sample without DOLFINx's
+assembler, and an expression at every cell without DOLFINx's coefficient packing.
 
 A sampled internal force (:mod:`fenics_drill.model.hyper_reduction`) lives on a handful of elements, and
 at every Newton iterate DOLFINx's ``assemble_vector`` spent about ten times longer in its set-up than in
 the kernels of those cells (benchmarks/RESULTS.md, issue 17).  :class:`CellAssembly` calls the form's
 generated ``tabulate_tensor`` directly, cell after cell, and adds each element vector at its dofs.  The
 kernel is called through its address, so the compiled loop is cached on disk like every other kernel.
+:class:`CellExpression` does the same for the von Mises probe's strain expression, at every accepted step.
 """
 
 from __future__ import annotations
@@ -51,6 +52,45 @@ def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, si
     return out
 
 
+@kernel
+def _tabulate_cells(address, coefficients, constants, coordinates, size):
+    """The element tensor of ``size`` values of every cell, one row per cell."""
+    out = np.zeros((coordinates.shape[0], size))
+    entity, permutation = np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
+    for c in range(coordinates.shape[0]):
+        _call_at(address, _FFI.from_buffer(out[c]), _FFI.from_buffer(coefficients[c]), _FFI.from_buffer(constants),
+                 _FFI.from_buffer(coordinates[c]), _FFI.from_buffer(entity), _FFI.from_buffer(permutation),
+                 _FFI.from_buffer(permutation))
+    return out
+
+
+def _cell_coordinates(mesh, cells: np.ndarray) -> np.ndarray:
+    """The coordinates of the geometry nodes of each cell, as the kernels take them (cells x nodes * 3)."""
+    return np.ascontiguousarray(mesh.geometry.x[mesh.geometry.dofmaps[0][cells]].reshape(len(cells), -1))
+
+
+class CellExpression:
+    """A ``dolfinx.fem.Expression`` of one function (block size 1) at every cell, from the function's dof
+    values: what ``Expression.eval`` gives, without packing the coefficients through DOLFINx."""
+
+    def __init__(self, expression: fem.Expression, function: fem.Function):
+        ufcx = expression._ufcx_expression
+        if ufcx.num_coefficients != 1 or function.function_space.dofmap.bs != 1:
+            raise ValueError("CellExpression takes an expression of one function of block size 1")
+        self.address = int(_FFI.cast("uintptr_t", ufcx.tabulate_tensor_float64))
+        mesh = function.function_space.mesh
+        cells = np.arange(mesh.topology.index_map(mesh.topology.dim).size_local, dtype=np.int32)
+        self.coordinates = _cell_coordinates(mesh, cells)
+        self.cell_dofs = np.ascontiguousarray(function.function_space.dofmap.list[cells])
+        self.constants = np.ascontiguousarray(fem.pack_constants(expression), dtype=float)
+        self.size = expression.X().shape[0] * int(np.prod(expression.value_shape, dtype=int))
+
+    def __call__(self, dofs: np.ndarray) -> np.ndarray:
+        """The expression at its points of every cell (cells x points * values)."""
+        return _tabulate_cells(self.address, np.ascontiguousarray(dofs[self.cell_dofs], dtype=float), self.constants,
+                               self.coordinates, self.size)
+
+
 class CellAssembly:
     """A linear form with one cell integral, assembled at the dofs ``dofs`` from packed coefficients."""
 
@@ -61,8 +101,7 @@ class CellAssembly:
         integral = form.ufcx_form.form_integrals[0]
         self.address = int(_FFI.cast("uintptr_t", integral.tabulate_tensor_float64))
         cells = form._cpp_object.domains(cell, 0)  # in the order of the packed coefficients
-        mesh = form.mesh
-        self.coordinates = np.ascontiguousarray(mesh.geometry.x[mesh.geometry.dofmaps[0][cells]].reshape(len(cells), -1))
+        self.coordinates = _cell_coordinates(form.mesh, cells)
         space = form.function_spaces[0]
         if space.dofmap.bs != 1:
             raise ValueError("CellAssembly takes a space of block size 1")
@@ -76,5 +115,5 @@ class CellAssembly:
 
     def __call__(self, coefficients: np.ndarray) -> np.ndarray:
         """The assembled vector at the dofs, from the cells' packed coefficients (cells x per cell)."""
-        return _assemble_cells(self.address, coefficients, self.constants, self.coordinates, self.cell_dofs,
-                               self.size)
+        return _assemble_cells(self.address, np.ascontiguousarray(coefficients, dtype=float), self.constants,
+                               self.coordinates, self.cell_dofs, self.size)

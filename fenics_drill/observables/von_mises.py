@@ -24,6 +24,7 @@ import numpy as np
 import ufl
 from dolfinx import fem
 
+from fenics_drill.model.cell_kernels import CellExpression
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.forms.energies import green_lagrange_strains, linear_strains, strain_slots
 
@@ -52,7 +53,7 @@ class VonMisesProbe:
         coefficients = [poly.terms.get(m, 0.0) for poly in strains for m in MONOMIALS]
         expression = ufl.as_vector([c if isinstance(c, ufl.core.expr.Expr) else ufl.as_ufl(c) for c in coefficients])
         self.expression = fem.Expression(expression, ELEMENT_POINTS)
-        self.mesh = disc.mesh
+        self._at_cells = CellExpression(self.expression, self.field)
         self.cells = np.arange(disc.mesh.topology.index_map(1).size_local, dtype=np.int32)
         y, z = outer_fibre(p.outer_radius).T
         self.monomials = np.stack([y**a * z**b for a, b in MONOMIALS])  # (6, samples)
@@ -66,8 +67,7 @@ class VonMisesProbe:
 
     def _coefficients(self, dofs: np.ndarray) -> np.ndarray:
         """Monomial coefficients of (eps_xx, eps_xy, eps_xz) at every point: (cells * points, 3, 6)."""
-        self.field.x.array[:] = dofs
-        return self.expression.eval(self.mesh, self.cells).reshape(-1, 3, len(MONOMIALS))
+        return self._at_cells(dofs).reshape(-1, 3, len(MONOMIALS))
 
     def _squared(self, c: np.ndarray) -> np.ndarray:
         """sigma_VM^2 on the outer fibre at the points of ``c`` (points, 3, 6): (points, samples)."""

@@ -82,3 +82,21 @@ def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
         assert np.all(np.abs(generalised - flat.T @ ref_nodal.ravel()) <= 1e-12 * magnitude.max())
         touched += int((ref_delta > 0).sum())
     assert touched > 20  # the states reach the wall, so the loads are tested
+
+
+def test_the_cells_kernels_give_dolfinx_evaluation_of_the_strain_expression():
+    """The von Mises probe's strain expression at every cell, from random dof values of the size of a drilling
+    state's (0.3 in SI units, every term of the Green-Lagrange strains active): the same kernel as DOLFINx's
+    Expression.eval, fed with the same coefficients, so equal to round-off (1e-13 of the largest value)."""
+    from fenics_drill.observables.von_mises import VonMisesProbe
+
+    disc = BeamDiscretization.from_scene(scene_with(*STRING))
+    probe = VonMisesProbe(disc)
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        dofs = 0.3 * rng.standard_normal(disc.ndofs)
+        probe.field.x.array[:] = dofs
+        reference = probe.expression.eval(disc.mesh, probe.cells)
+        ours = probe._at_cells(dofs)
+        assert np.abs(reference).max() > 0
+        np.testing.assert_allclose(ours, reference.reshape(ours.shape), rtol=0, atol=1e-13 * np.abs(reference).max())
