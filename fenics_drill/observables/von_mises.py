@@ -23,8 +23,10 @@ from __future__ import annotations
 import numpy as np
 import ufl
 from dolfinx import fem
+from numba import njit
 
 from fenics_drill.model.cell_kernels import CellExpression
+from fenics_drill.model.compiled import kernel
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.forms.energies import green_lagrange_strains, linear_strains, strain_slots
 
@@ -33,6 +35,45 @@ MONOMIALS = ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2))
 #: Points per element where the stress is evaluated (reference coordinate).
 ELEMENT_POINTS = np.array([[0.0], [0.5], [1.0]])
 SECTION_ANGLES = 48
+
+
+@njit(cache=True)
+def _von_mises_squared(exx, exy, exz, young_modulus, shear_modulus):
+    """sigma_VM^2 = sigma_xx^2 + 3 (tau_xy^2 + tau_xz^2) with sigma_xx = E eps_xx, tau = 2 G eps."""
+    return young_modulus**2 * exx * exx + 12.0 * shear_modulus**2 * (exy * exy + exz * exz)
+
+
+@kernel
+def _sampled_maxima(c, points, monomials, young_modulus, shear_modulus):
+    """The largest sigma_VM^2 over the outer fibre's samples at each of ``points``, from the monomial
+    coefficients ``c`` (points, 3 strains, 6 monomials) and the monomials at the samples (6, samples)."""
+    out = np.empty(points.size)
+    for k in range(points.size):
+        p, largest = points[k], 0.0
+        for s in range(monomials.shape[1]):
+            exx = exy = exz = 0.0
+            for m in range(monomials.shape[0]):
+                exx += c[p, 0, m] * monomials[m, s]
+                exy += c[p, 1, m] * monomials[m, s]
+                exz += c[p, 2, m] * monomials[m, s]
+            largest = max(largest, _von_mises_squared(exx, exy, exz, young_modulus, shear_modulus))
+        out[k] = largest
+    return out
+
+
+@kernel
+def _bounds(c, monomial_bounds, young_modulus, shear_modulus):
+    """An upper bound of sigma_VM^2 over the whole outer fibre at every point of ``c``: each strain is
+    bounded by the sum of its monomials' largest magnitudes on the circle r = R_ext."""
+    out = np.empty(c.shape[0])
+    for p in range(c.shape[0]):
+        exx = exy = exz = 0.0
+        for m in range(monomial_bounds.size):
+            exx += abs(c[p, 0, m]) * monomial_bounds[m]
+            exy += abs(c[p, 1, m]) * monomial_bounds[m]
+            exz += abs(c[p, 2, m]) * monomial_bounds[m]
+        out[p] = _von_mises_squared(exx, exy, exz, young_modulus, shear_modulus)
+    return out
 
 
 def outer_fibre(outer_radius: float, angles: int = SECTION_ANGLES) -> np.ndarray:
@@ -69,34 +110,25 @@ class VonMisesProbe:
         """Monomial coefficients of (eps_xx, eps_xy, eps_xz) at every point: (cells * points, 3, 6)."""
         return self._at_cells(dofs).reshape(-1, 3, len(MONOMIALS))
 
-    def _squared(self, c: np.ndarray) -> np.ndarray:
-        """sigma_VM^2 on the outer fibre at the points of ``c`` (points, 3, 6): (points, samples)."""
-        exx, exy, exz = (c[:, i] @ self.monomials for i in range(3))
-        return self.E**2 * exx**2 + 12.0 * self.G**2 * (exy**2 + exz**2)
-
-    def _bound(self, c: np.ndarray) -> np.ndarray:
-        """An upper bound of sigma_VM^2 over the whole outer fibre at every point of ``c``: each strain
-        is bounded by the sum of its monomials' largest magnitudes on the circle r = R_ext."""
-        exx, exy, exz = (np.abs(c[:, i]) @ self.monomial_bounds for i in range(3))
-        return self.E**2 * exx**2 + 12.0 * self.G**2 * (exy**2 + exz**2)
-
     def stress(self, dofs: np.ndarray) -> np.ndarray:
         """Maximum of sigma_VM over each sampled section, shape (cells, points) [Pa]."""
-        squared = self._squared(self._coefficients(dofs))
-        return np.sqrt(squared.max(axis=1)).reshape(len(self.cells), len(ELEMENT_POINTS))
+        c = self._coefficients(dofs)
+        squared = _sampled_maxima(c, np.arange(len(c)), self.monomials, self.E, self.G)
+        return np.sqrt(squared).reshape(len(self.cells), len(ELEMENT_POINTS))
 
     def maximum(self, dofs: np.ndarray) -> tuple[float, float]:
         """(max sigma_VM [Pa], x where it occurs [m]) over the whole string.
 
         The same maximum as :meth:`stress`, at a fraction of its cost: the sections are sampled only
-        where the bound of :meth:`_bound` reaches the stress sampled at the section of largest bound."""
+        where the bound of :func:`_bounds` reaches the stress sampled at the section of largest bound."""
         c = self._coefficients(dofs)
-        bound = self._bound(c)
-        first = int(np.argmax(bound))
+        bound = _bounds(c, self.monomial_bounds, self.E, self.G)
+        first = np.array([np.argmax(bound)])
         # (1 - 1e-9): the bound and the sampled stress are equal where one monomial carries the strain,
         # and round-off must not drop that section
-        candidates = np.flatnonzero(bound >= (1.0 - 1e-9) * self._squared(c[first:first + 1]).max())
-        squared = self._squared(c[candidates]).max(axis=1)
+        reached = (1.0 - 1e-9) * _sampled_maxima(c, first, self.monomials, self.E, self.G)[0]
+        candidates = np.flatnonzero(bound >= reached)
+        squared = _sampled_maxima(c, candidates, self.monomials, self.E, self.G)
         k = int(candidates[np.argmax(squared)])
         return float(np.sqrt(squared.max())), float(self.x.flat[k])
 

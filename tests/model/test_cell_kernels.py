@@ -8,7 +8,7 @@ from dolfinx import fem
 
 from fenics_drill.model.cell_kernels import CellAssembly
 from fenics_drill.model.discretization import BeamDiscretization
-from fenics_drill.model.forces.wall_contact import _modal_pass, _vertex_loads
+from fenics_drill.model.forces.wall_contact import _contact_blocks, _modal_pass, _vertex_loads
 from fenics_drill.model.internal_force import ElementSample, InternalForms
 from fenics_drill.solvers.static import solve_static
 from fenics_drill.studies.prepare import prepare
@@ -114,3 +114,37 @@ def test_the_cells_kernels_give_dolfinx_evaluation_of_the_strain_expression():
         # the same kernel on the same coefficients: equal but for round-off of the largest value's size
         np.testing.assert_allclose(ours, reference.reshape(ours.shape), rtol=0,
                                    atol=1e-13 * np.abs(reference).max())
+
+
+def test_the_wall_tangent_of_a_modal_space_is_its_double_precision_product_to_single_round_off():
+    """In a modal space the wall's tangent R^T (A R) is formed in single precision (it steers Newton only;
+    the residual, in double precision, decides convergence).  Against R^T (A R) in double precision at 10
+    states pressed into the wall, each entry is within the bound of a single-precision product: both
+    factors rounded once (2 u) and a sum of k products in any order (k u, Higham Sec. 3.1), times
+    sum |R| |A R|, with u the unit round-off of float32.  A tangent off by 1e-4 of its largest entry
+    breaks that bound, so the test can fail."""
+    scene = scene_with(*STRING)
+    model = prepare(scene, dynamics=False).model
+    resting = solve_static(model).q
+    wall = model.force("wall")
+    rng = np.random.default_rng(5)
+    u = np.finfo(np.float32).eps / 2
+    for _ in range(10):
+        q = resting * (1 + 0.05 * rng.standard_normal(model.size))
+        radius = np.sort(np.hypot(*(rows @ q for rows in model.lateral_rows)))
+        q *= 1.03 * model.gap / radius[-3]  # at least three vertices pressed into the wall
+        qd = rng.standard_normal(model.size) * 0.5
+        forces = wall.evaluate(q, qd, with_tangent=True)
+        c_u, c_v = 1.0, 1e3
+        tangent = wall.tangent(forces, c_u, c_v)
+        flat, lateral, rates = forces.tangent_data
+        active = np.flatnonzero(forces.delta > 0)
+        blocks = _contact_blocks(active, lateral, rates, *wall._law(), c_u, c_v)
+        rows = flat.reshape(-1, 4, model.size)[active]  # (vertex, field, column)
+        weighted = np.einsum("vof,vfj->voj", blocks, rows)
+        reference = np.einsum("voi,voj->ij", rows, weighted)
+        k = 4 * active.size
+        bound = (k + 2) * u * np.einsum("voi,voj->ij", np.abs(rows), np.abs(weighted))
+        assert np.all(np.abs(tangent - reference) <= bound)
+        assert np.any(np.abs(tangent + 1e-4 * np.abs(reference).max() - reference) > bound)
+        assert np.abs(reference).max() > 0

@@ -8,38 +8,79 @@ projects them on the solution space and differentiates them for the Newton tange
 from __future__ import annotations
 
 import copy
+import math
 from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
+from numba import njit
 
+from fenics_drill.model.compiled import kernel
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
 from fenics_drill.scene import LAW_SIGN
 
 
+@njit(cache=True)
+def _force(bit_velocity, limit_force, rate):
+    """(20) at one instant."""
+    return limit_force * math.expm1(-rate * bit_velocity) if bit_velocity > 0.0 else 0.0
+
+
+@njit(cache=True)
+def _regularisation(omega):
+    """(22) at one instant."""
+    return math.tanh(omega) + 2.0 * omega / (1.0 + omega * omega)
+
+
+@njit(cache=True)
+def _regularisation_slope(omega):
+    """d xi_BR / d omega of (22) at one instant; 1 - tanh^2 without overflow at large omega."""
+    tanh = math.tanh(omega)
+    return 1.0 - tanh * tanh + 2.0 * (1.0 - omega * omega) / (1.0 + omega * omega) ** 2
+
+
+@njit(cache=True)
+def _torque(bit_force, bit_spin_rate, friction, borehole_radius):
+    """(21) at one instant."""
+    return -friction * abs(bit_force) * borehole_radius * _regularisation(bit_spin_rate)
+
+
+@kernel
+def _law(bit_velocity, bit_spin_rate, limit_force, rate, friction, borehole_radius):
+    """(20)-(22) at the bit and their derivatives: F_BR, T_BR, dF_BR/du_dot, dT_BR/du_dot, dT_BR/d omega."""
+    force = _force(bit_velocity, limit_force, rate)
+    xi = _regularisation(bit_spin_rate)
+    d_force = -limit_force * rate * math.exp(-rate * bit_velocity) if bit_velocity > 0.0 else 0.0
+    # T = -mu |F| R xi = mu F R xi  (F <= 0)
+    return (force, _torque(force, bit_spin_rate, friction, borehole_radius), d_force,
+            friction * borehole_radius * xi * d_force,
+            friction * force * borehole_radius * _regularisation_slope(bit_spin_rate))
+
+
+_FORCE, _TORQUE = np.vectorize(_force, otypes=(float,)), np.vectorize(_torque, otypes=(float,))
+_REGULARISATION = np.vectorize(_regularisation, otypes=(float,))
+_REGULARISATION_SLOPE = np.vectorize(_regularisation_slope, otypes=(float,))
+
+
 def bit_rock_force(bit_velocity, limit_force, rate):
     """F_BR = Gamma_BR (exp(-alpha_BR u_dot_bit) - 1) for u_dot_bit > 0, else 0, Eq. (20)."""
-    u = np.asarray(bit_velocity, dtype=float)
-    return np.where(u > 0, limit_force * np.expm1(-rate * np.maximum(u, 0.0)), 0.0)
+    return _FORCE(bit_velocity, limit_force, rate)
 
 
 def torque_regularisation(omega):
     """xi_BR(omega) = tanh(omega) + 2 omega / (1 + omega^2), Eq. (22); odd, sign of omega."""
-    omega = np.asarray(omega, dtype=float)
-    return np.tanh(omega) + 2.0 * omega / (1.0 + omega**2)
+    return _REGULARISATION(omega)
 
 
 def bit_rock_torque(bit_force, bit_spin_rate, friction, borehole_radius):
     """T_BR = -mu_BR |F_BR| R_bh xi_BR(omega_bit), Eq. (21) with the magnitude of F_BR."""
-    return -friction * np.abs(bit_force) * borehole_radius * torque_regularisation(bit_spin_rate)
+    return _TORQUE(bit_force, bit_spin_rate, friction, borehole_radius)
 
 
 def torque_regularisation_slope(omega):
     """d xi_BR / d omega of Eq. (22)."""
-    omega = np.asarray(omega, dtype=float)
-    # 1 - tanh^2 = 1 / cosh^2, without overflow at the large omega of a Newton trial iterate
-    return 1.0 - np.tanh(omega) ** 2 + 2.0 * (1.0 - omega**2) / (1.0 + omega**2) ** 2
+    return _REGULARISATION_SLOPE(omega)
 
 
 #: A Newton update that crosses a kink is cut this much (relatively) past it, on the new branch.
@@ -104,14 +145,9 @@ class BitRock:
         return {"bit_force": forces.force, "bit_torque": forces.torque}
 
     def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> BitForces:
-        u_dot, omega = (float(value) for value in self.rows.values(qd))
-        force = float(bit_rock_force(u_dot, self.limit_force, self.rate))
-        torque = float(bit_rock_torque(force, omega, self.friction, self.borehole_radius))
-        d_force = -self.limit_force * self.rate * np.exp(-self.rate * u_dot) if u_dot > 0 else 0.0
-        xi = float(torque_regularisation(omega))
-        # T = -mu |F| R xi = mu F R xi  (F <= 0)
-        d_torque_velocity = self.friction * self.borehole_radius * xi * d_force
-        d_torque_spin = self.friction * force * self.borehole_radius * float(torque_regularisation_slope(omega))
+        u_dot, omega = self.rows.values(qd).tolist()
+        force, torque, d_force, d_torque_velocity, d_torque_spin = _law(
+            u_dot, omega, self.limit_force, self.rate, self.friction, self.borehole_radius)
         laws = {"bit_rock_force": self.rows.spread(np.array([force, 0.0])),
                 "bit_rock_torque": self.rows.spread(np.array([0.0, torque]))}
         generalised = laws["bit_rock_force"] + laws["bit_rock_torque"]

@@ -11,6 +11,7 @@ for the Newton tangent.
 from __future__ import annotations
 
 import copy
+import functools
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import ClassVar
@@ -210,23 +211,24 @@ def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_ax
 
 @kernel
 def _weighted_rows(flat, active, blocks):
-    """R, the rows of (u, v, w, theta_x) of the dense [Phi] at the vertices in contact, and A R for the
-    blocks A of :func:`_contact_blocks`: the wall's tangent is R^T (A R)."""
+    """R^T and A R in single precision: R, the rows of (u, v, w, theta_x) of the dense [Phi] at the vertices
+    in contact, A the blocks of :func:`_contact_blocks`; the wall's tangent is R^T (A R)."""
     size = flat.shape[1]
-    rows = np.empty((4 * active.size, size))
-    weighted = np.zeros((4 * active.size, size))
+    transposed = np.empty((size, 4 * active.size), dtype=np.float32)
+    weighted = np.zeros((4 * active.size, size), dtype=np.float32)
     for k in range(active.size):
         for f in range(4):
             source = 4 * active[k] + f
             for j in range(size):
-                rows[4 * k + f, j] = flat[source, j]
+                transposed[j, 4 * k + f] = flat[source, j]
         for o in range(4):
             for f in range(4):
                 a = blocks[k, o, f]
                 if a != 0.0:
+                    source = 4 * active[k] + f
                     for j in range(size):
-                        weighted[4 * k + o, j] += a * rows[4 * k + f, j]
-    return rows, weighted
+                        weighted[4 * k + o, j] += a * flat[source, j]
+    return transposed, weighted
 
 
 def _selection(rows: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
@@ -269,18 +271,48 @@ class ProjectedLaws(Mapping):
 
 @dataclass
 class WallForces(ForceEvaluation):
-    """Nodal state and forces of one evaluation (arrays over the vertices).
+    """Nodal state and forces of one evaluation.
 
     ``generalised`` is [Phi]^T of (50); ``laws`` splits its non-conservative part into the damper of
     (17), the axial friction (18) and the friction torque (19); ``potential`` is the sum of
-    k1 delta^2 / 2 + k2 delta^4 / 4 over the vertices in contact."""
+    k1 delta^2 / 2 + k2 delta^4 / 4 over the vertices in contact.  The arrays over the vertices are
+    derived on first read (Newton's iterates read none of them)."""
 
-    indentation: np.ndarray = None
-    in_contact: np.ndarray = None
-    normal: np.ndarray = None  # F_n (<= 0)
-    axial: np.ndarray = None  # F_a
-    torque: np.ndarray = None  # T_FS
-    derivatives: dict | None = None
+    vertex_count: int = 0
+    vertices: np.ndarray = None  # the vertices evaluated
+    delta: np.ndarray = None  # their indentations
+    nodal: np.ndarray = None  # their loads (F_a, F_v, F_w, T)
+    tangent_data: tuple | None = None  # what :meth:`WallContact.tangent` needs, if asked for
+
+    @functools.cached_property
+    def indentation(self) -> np.ndarray:
+        """delta of (16) at every vertex; -inf at the vertices left out (too far from the wall)."""
+        out = np.full(self.vertex_count, -np.inf)
+        out[self.vertices] = self.delta
+        return out
+
+    @functools.cached_property
+    def in_contact(self) -> np.ndarray:
+        return self.indentation > 0
+
+    @functools.cached_property
+    def _active(self) -> np.ndarray:
+        return self.nodal[self.delta > 0]
+
+    @property
+    def normal(self) -> np.ndarray:
+        """F_n (<= 0) at the vertices in contact."""
+        return -np.hypot(self._active[:, 1], self._active[:, 2])
+
+    @property
+    def axial(self) -> np.ndarray:
+        """F_a at the vertices in contact."""
+        return self._active[:, 0]
+
+    @property
+    def torque(self) -> np.ndarray:
+        """T_FS at the vertices in contact."""
+        return self._active[:, 3]
 
 
 @dataclass(frozen=True)
@@ -399,23 +431,20 @@ class WallContact:
         else:
             delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(vertex_set.flat, q, qd,
                                                                                      *self._law())
-        active = np.flatnonzero(delta > 0)
-        indentation = np.full(len(self.x), -np.inf)
-        indentation[vertex_set.vertices] = delta
-        out = WallForces(generalised, potential,
-                         ProjectedLaws(vertex_set.flat, laws), indentation, indentation > 0,
-                         -np.hypot(nodal[active, 1], nodal[active, 2]), nodal[active, 0], nodal[active, 3])
+        out = WallForces(generalised, potential, ProjectedLaws(vertex_set.flat, laws), len(self.x),
+                         vertex_set.vertices, delta, nodal)
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
-            out.derivatives = {"at": (vertex_set.flat, active, lateral, rates)}
+            out.tangent_data = (vertex_set.flat, lateral, rates)
         return out
 
     def tangent(self, forces: WallForces, c_u: float, c_v: float):
         """c_u d f/dq + c_v d f/dqd of the generalised wall force (None without contact):
         sum over the vertices in contact of R_i^T A_i R_i, with R_i the four rows of [Phi] of
         vertex i and A_i the 4 x 4 block of the pointwise derivatives."""
-        if forces.derivatives is None:
+        if forces.tangent_data is None:
             return None
-        flat, active, lateral, rates = forces.derivatives["at"]
+        flat, lateral, rates = forces.tangent_data
+        active = np.flatnonzero(forces.delta > 0)
         if active.size == 0:
             return None
         blocks = _contact_blocks(active, lateral, rates, *self._law(), c_u, c_v)
@@ -427,5 +456,5 @@ class WallContact:
             data = scale[:, :, None] * blocks * scale[:, None, :]
             kept = (rows >= 0) & (columns >= 0) & (data != 0.0)
             return sp.coo_matrix((data[kept], (rows[kept], columns[kept])), shape=(flat.shape[1],) * 2)
-        rows, weighted = _weighted_rows(flat, active, blocks)
-        return rows.T @ weighted
+        transposed, weighted = _weighted_rows(flat, active, blocks)
+        return (transposed @ weighted).astype(float)
