@@ -4,8 +4,9 @@ assembler, and an expression at every cell without DOLFINx's coefficient packing
 A sampled internal force (:mod:`fenics_drill.model.hyper_reduction`) lives on a handful of elements, and
 at every Newton iterate DOLFINx's ``assemble_vector`` spent about ten times longer in its set-up than in
 the kernels of those cells (benchmarks/RESULTS.md, issue 17).  :class:`CellAssembly` calls the form's
-generated ``tabulate_tensor`` directly, cell after cell, and adds each element vector at its dofs.  The
-kernel is called through its address, so the compiled loop is cached on disk like every other kernel.
+generated ``tabulate_tensor`` directly, cell after cell, and adds each element tensor at its dofs: the
+sampled force, its tangents and its energies.  The kernel is called through its address, so the compiled
+loop is cached on disk like every other kernel.
 :class:`CellExpression` does the same for the von Mises probe's strain expression, at every accepted step.
 """
 
@@ -37,18 +38,25 @@ def _call_at(typingctx, address, element, coefficients, constants, coordinates, 
 
 
 @kernel
-def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, size):
-    """sum over the cells of their element vectors, at the positions ``cell_dofs`` of a vector of ``size``."""
-    out = np.zeros(size)
-    element = np.empty(cell_dofs.shape[1])
+def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, size, square):
+    """sum over the cells of their element tensors at the positions ``cell_dofs``: a vector of ``size``, or
+    with ``square`` a (size x size) matrix, row-major (the element matrix's rows are its test functions)."""
+    n = cell_dofs.shape[1]
+    out = np.zeros(size * size if square else size)
+    element = np.empty(n * n if square else n)
     entity, permutation = np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
     for c in range(cell_dofs.shape[0]):
         element[:] = 0.0
         _call_at(address, _FFI.from_buffer(element), _FFI.from_buffer(coefficients[c]), _FFI.from_buffer(constants),
                  _FFI.from_buffer(coordinates[c]), _FFI.from_buffer(entity), _FFI.from_buffer(permutation),
                  _FFI.from_buffer(permutation))
-        for k in range(cell_dofs.shape[1]):
-            out[cell_dofs[c, k]] += element[k]
+        if square:
+            for k in range(n):
+                for m in range(n):
+                    out[cell_dofs[c, k] * size + cell_dofs[c, m]] += element[k * n + m]
+        else:
+            for k in range(n):
+                out[cell_dofs[c, k]] += element[k]
     return out
 
 
@@ -92,28 +100,39 @@ class CellExpression:
 
 
 class CellAssembly:
-    """A linear form with one cell integral, assembled at the dofs ``dofs`` from packed coefficients."""
+    """A form with one cell integral assembled from packed coefficients: a functional (a number), a linear
+    form (a vector at the dofs ``dofs``) or a bilinear form of one space (a dense matrix at those dofs)."""
 
-    def __init__(self, form: fem.Form, dofs: np.ndarray):
+    def __init__(self, form: fem.Form, dofs: np.ndarray | None = None):
         cell = fem.IntegralType.cell
-        if form.rank != 1 or set(form.integral_types) != {cell} or form.num_integrals(cell, 0) != 1:
-            raise ValueError("CellAssembly takes a linear form with exactly one cell integral")
+        if set(form.integral_types) != {cell} or form.num_integrals(cell, 0) != 1:
+            raise ValueError("CellAssembly takes a form with exactly one cell integral")
+        if form.rank == 2 and form.function_spaces[0] is not form.function_spaces[1]:
+            raise ValueError("CellAssembly takes a bilinear form of one space")
         integral = form.ufcx_form.form_integrals[0]
         self.address = int(_FFI.cast("uintptr_t", integral.tabulate_tensor_float64))
         cells = form._cpp_object.domains(cell, 0)  # in the order of the packed coefficients
         self.coordinates = _cell_coordinates(form.mesh, cells)
-        space = form.function_spaces[0]
-        if space.dofmap.bs != 1:
-            raise ValueError("CellAssembly takes a space of block size 1")
-        position = np.full(space.dofmap.index_map.size_local + space.dofmap.index_map.num_ghosts, -1, dtype=np.int64)
-        position[dofs] = np.arange(len(dofs))
-        self.cell_dofs = np.ascontiguousarray(position[space.dofmap.map()[cells]])
-        if (self.cell_dofs < 0).any():
-            raise ValueError("the sampled cells touch dofs outside the given ones")
+        self.rank = form.rank
+        if self.rank == 0:
+            self.cell_dofs, self.size = np.zeros((len(cells), 1), dtype=np.int64), 1
+        else:
+            space = form.function_spaces[0]
+            if space.dofmap.bs != 1:
+                raise ValueError("CellAssembly takes a space of block size 1")
+            index_map = space.dofmap.index_map
+            position = np.full(index_map.size_local + index_map.num_ghosts, -1, dtype=np.int64)
+            position[dofs] = np.arange(len(dofs))
+            self.cell_dofs = np.ascontiguousarray(position[space.dofmap.map()[cells]])
+            if (self.cell_dofs < 0).any():
+                raise ValueError("the sampled cells touch dofs outside the given ones")
+            self.size = len(dofs)
         self.constants = np.ascontiguousarray(fem.pack_constants(form), dtype=float)
-        self.size = len(dofs)
 
-    def __call__(self, coefficients: np.ndarray) -> np.ndarray:
-        """The assembled vector at the dofs, from the cells' packed coefficients (cells x per cell)."""
-        return _assemble_cells(self.address, np.ascontiguousarray(coefficients, dtype=float), self.constants,
-                               self.coordinates, self.cell_dofs, self.size)
+    def __call__(self, coefficients: np.ndarray):
+        """The assembled number, vector or matrix, from the cells' packed coefficients (cells x per cell)."""
+        out = _assemble_cells(self.address, np.ascontiguousarray(coefficients, dtype=float), self.constants,
+                              self.coordinates, self.cell_dofs, self.size, self.rank == 2)
+        if self.rank == 0:
+            return float(out[0])
+        return out.reshape(self.size, self.size) if self.rank == 2 else out

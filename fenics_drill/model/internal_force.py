@@ -29,7 +29,7 @@ from petsc4py import PETSc
 from fenics_drill.forms import energies
 from fenics_drill.model.cell_kernels import CellAssembly
 from fenics_drill.model.discretization import BeamDiscretization
-from fenics_drill.model.operators import LinearOperators, petsc_to_scipy
+from fenics_drill.model.operators import LinearOperators
 
 
 class LinearInternalForce:
@@ -156,17 +156,18 @@ class AssembledInternalForce:
         if sample is None:  # DOLFINx's own CSR matrices, read at the entries that matter
             self._matrices = tuple(TangentEntries(form, space, forms.functions) if form is not None
                                    else None for form in self._jacobians)
-        else:  # the nonlinear remainder; the linear part is applied with the projected matrices
+        else:  # the nonlinear remainder on the sampled cells, from (q, qd, qdd) through their kernels
             self.linear = tuple(space.project_matrix(m) for m in (operators.stiffness, operators.damping,
                                                                    operators.mass))
             self._linear_rows = np.hstack(self.linear)  # [K C M]: the linear part of (q, qd, qdd) stacked
             self.weight, self.phi_rows = forms.weight, space.phi[self.dofs]  # the sample's weight per cell
-            self._sampled_dofs = PETSc.IS().createGeneral(self.dofs)  # the sampled cells touch these dofs only
-            self._matrices = tuple(fem_petsc.create_matrix(form) if form is not None else None
-                                   for form in self._jacobians)
+            U, V, _ = forms.functions
+            self._packing = SampledCoefficients(self._residual, forms.functions, self.dofs, self.phi_rows)
+            self._tangent_cells = tuple(SampledCoefficients(form, forms.functions, self.dofs, self.phi_rows)
+                                        if form is not None else None for form in self._jacobians)
+            self._kinetic_cells = SampledCoefficients(self._kinetic, (U, V), self.dofs, self.phi_rows)
+            self._strain_cells = SampledCoefficients(self._strain, (U,), self.dofs, self.phi_rows)
         self._damping = space.project_matrix(operators.damping)  # (45) is linear: reused for the budget
-        self._packing = SampledCoefficients(self._residual, forms.functions, self.dofs, self.phi_rows) \
-            if sample is not None else None
         # (q, qd, qdd) of the last evaluation, set on the functions when a tangent needs it (other forces on
         # the same string share the functions, so a tangent never assumes they still hold this state)
         self._state = None
@@ -202,44 +203,43 @@ class AssembledInternalForce:
         linear = self.linear[k] if self.dofs is not None else None
         if self._jacobians[k] is None:
             return linear if linear is not None else self.space.zeros_matrix()
-        matrix = self._matrices[k]
         if self.dofs is None:
-            return matrix.assemble()
-        matrix.zeroEntries()
-        fem_petsc.assemble_matrix(matrix, self._jacobians[k])
-        matrix.assemble()
-        block = petsc_to_scipy(matrix.createSubMatrix(self._sampled_dofs, self._sampled_dofs))
+            return self._matrices[k].assemble()
+        block = self._tangent_cells[k].assemble(np.concatenate(self._state))
         return self.phi_rows.T @ (block @ self.phi_rows) + linear
 
     def tangent_parts(self, needed=(True, True, True)):
         """(df/dq, df/dqd, df/dqdd) at the state of the last :meth:`evaluate`; None for a part not
         ``needed`` (a static solve needs df/dq only: one assembly instead of three)."""
-        if self._state is not None:  # a sampled evaluation packs its coefficients without the functions, and
-            for function, values in zip((self.U, self.V, self.A), self._state):  # other models share them
+        if self.dofs is None and self._state is not None:  # other models share the functions
+            for function, values in zip((self.U, self.V, self.A), self._state):
                 self._set(function, values)
         return tuple(self._part(k) if want else None for k, want in enumerate(needed))
 
     def kinetic_energy(self, q, qd) -> float:
+        if self.dofs is not None:
+            return self._kinetic_cells.assemble(np.concatenate((q, qd))) + 0.5 * float(qd @ (self.linear[2] @ qd))
         self._set(self.U, q)
         self._set(self.V, qd)
-        value = fem.assemble_scalar(self._kinetic)
-        return value if self.dofs is None else value + 0.5 * float(qd @ (self.linear[2] @ qd))
+        return fem.assemble_scalar(self._kinetic)
 
     def strain_energy(self, q) -> float:
+        if self.dofs is not None:
+            return self._strain_cells.assemble(q) + 0.5 * float(q @ (self.linear[0] @ q))
         self._set(self.U, q)
-        value = fem.assemble_scalar(self._strain)
-        return value if self.dofs is None else value + 0.5 * float(q @ (self.linear[0] @ q))
+        return fem.assemble_scalar(self._strain)
 
     def damping_force(self, qd) -> np.ndarray:
         return self._damping @ qd
 
 
 class SampledCoefficients:
-    """A vector form on the sampled cells assembled from coefficients packed directly from (q, qd, qdd).
+    """A form on the sampled cells (the force, a tangent, an energy) assembled from coefficients packed
+    directly from the reduced values of its ``functions`` (q, qd, qdd of U, V, A, stacked).
 
     The packed coefficients of the cells (what ``dolfinx.fem.pack_coefficients`` gives: the weight and
-    the dofs of U, V, A on each cell) are an affine function of the reduced state, found once by packing
-    the columns of [Phi]; an evaluation is then one small product and the cells' kernels
+    the dofs of the functions on each cell) are an affine function of the reduced state, found once by
+    packing the columns of [Phi]; an evaluation is then one small product and the cells' kernels
     (:class:`~fenics_drill.model.cell_kernels.CellAssembly`), without setting the functions or DOLFINx's
     packing and assembly paths."""
 
@@ -257,8 +257,9 @@ class SampledCoefficients:
         self.map = np.ascontiguousarray(np.column_stack(columns))
         self.cells = CellAssembly(form, dofs)
 
-    def assemble(self, state: np.ndarray) -> np.ndarray:
-        """The assembled vector at the sampled dofs at the reduced state (q, qd, qdd) stacked in one vector."""
+    def assemble(self, state: np.ndarray):
+        """The assembled number, vector or matrix (at the sampled dofs) at the reduced state of the functions,
+        stacked in one vector."""
         return self.cells((self.offset + self.map @ state).reshape(self.shape))
 
 

@@ -3,6 +3,7 @@ the wall law in one pass over a modal space's rows (fenics_drill/model/forces/wa
 
 import numpy as np
 import pytest
+import ufl
 from conftest import scene_with
 from dolfinx import fem
 
@@ -49,10 +50,40 @@ def test_the_cells_kernels_give_dolfinx_assembly_of_the_sampled_force(sampled_fo
         assert np.abs(np.delete(reference, forms.dofs)).max() == 0.0
 
 
-def test_cell_assembly_refuses_a_bilinear_form(sampled_forms):
+def test_the_cells_kernels_give_dolfinx_assembly_of_the_sampled_tangents_and_energies(sampled_forms):
+    """The same for the sampled tangents df/dq, df/dqd, df/dqdd (dense at the sampled dofs, against DOLFINx's
+    assemble_matrix) and the kinetic and strain energies (against assemble_scalar): the same element tensors
+    added in another order, so round-off of the largest entry (1e-13)."""
     disc, forms = sampled_forms
-    with pytest.raises(ValueError, match="linear form"):
-        CellAssembly(forms.jacobians[0], forms.dofs)
+    rng = np.random.default_rng(8)
+    for _ in range(2):
+        for function in forms.functions:
+            function.x.array[:] = 0.3 * rng.standard_normal(function.x.array.size)
+        for jacobian in forms.jacobians:
+            if jacobian is None:
+                continue
+            (key, packed), = fem.pack_coefficients(jacobian).items()
+            reference = fem.assemble_matrix(jacobian).to_dense()
+            ours = CellAssembly(jacobian, forms.dofs)(packed)
+            assert np.abs(reference).max() > 0
+            np.testing.assert_allclose(ours, reference[np.ix_(forms.dofs, forms.dofs)], rtol=0,
+                                       atol=1e-13 * np.abs(reference).max())
+            untouched = np.ones(reference.shape, dtype=bool)
+            untouched[np.ix_(forms.dofs, forms.dofs)] = False
+            assert np.abs(reference[untouched]).max() == 0.0
+        for energy in (forms.kinetic, forms.strain):
+            (key, packed), = fem.pack_coefficients(energy).items()
+            reference = fem.assemble_scalar(energy)
+            assert reference != 0.0
+            assert CellAssembly(energy)(packed) == pytest.approx(reference, rel=1e-13, abs=0.0)
+
+
+def test_cell_assembly_refuses_a_bilinear_form_of_two_spaces(sampled_forms):
+    disc, forms = sampled_forms
+    weights = fem.functionspace(disc.mesh, ("DG", 0))
+    mixed = fem.form(ufl.TrialFunction(weights) * ufl.TestFunction(disc.V)[0] * ufl.dx(domain=disc.mesh))
+    with pytest.raises(ValueError, match="one space"):
+        CellAssembly(mixed, forms.dofs)
 
 
 def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
