@@ -217,16 +217,14 @@ def select_modes(basis: ModalBasis, scene) -> np.ndarray:
     return np.flatnonzero(keep)
 
 
-def stuck_bit_modes(disc: BeamDiscretization, f_star_max: float, mass, stiffness) -> ModalBasis:
-    """Torsional modes of the string held by the drive and stuck at the bit (theta_x held at both ends):
-    the fixed-fixed waves n c_T / 2L that ring while the bit sticks (stick-slip, Section 6.9).  The modes of
-    the free bit alone reach the bit's stuck state only through many of them; with these, the basis
-    spans both phases, as the fixed-interface modes of Craig & Bampton (1968) with the static bit
-    responses of the guard as constraint modes.  Torsion is uncoupled from the other fields in the
-    linear operators (46), so the theta_x block alone is solved (dense, a few hundred dofs)."""
+def _field_modes(disc: BeamDiscretization, field: int, held_ends: tuple, f_star_max: float, mass, stiffness,
+                 kind: str) -> ModalBasis:
+    """The modes of one field's block of (62) up to ``f_star_max``, with the field held at ``held_ends``
+    (0: x = 0, 1: x = L) and at the supports.  The linear operators (46) couple neither u nor theta_x with
+    any other field, so their blocks alone give their modes (dense, a few hundred dofs)."""
     p = disc.properties
-    dofs = disc.field_dofs[THETA_X]
-    inner = np.setdiff1d(dofs, [disc.end_dof(THETA_X, 0), disc.end_dof(THETA_X, 1)])
+    held = [disc.end_dof(field, end) for end in held_ends]
+    inner = np.setdiff1d(disc.field_dofs[field], np.concatenate([held, disc.support_dofs]).astype(int))
     K = sp.csr_matrix(stiffness)[inner][:, inner].toarray()
     M = sp.csr_matrix(mass)[inner][:, inner].toarray()
     omega_max = 2.0 * math.pi * f_star_max * p.longitudinal_wave_speed / p.length
@@ -235,8 +233,33 @@ def stuck_bit_modes(disc: BeamDiscretization, f_star_max: float, mass, stiffness
     vectors[inner] = block  # M-orthonormal: eigh normalises block^T M block = I
     freqs = np.sqrt(eigenvalues) / (2.0 * math.pi)
     fractions = field_mass_fractions(mass, disc.field_of_dof, vectors)
-    return ModalBasis(freqs, freqs * p.length / p.longitudinal_wave_speed, ["torsional"] * eigenvalues.size,
+    return ModalBasis(freqs, freqs * p.length / p.longitudinal_wave_speed, [kind] * eigenvalues.size,
                       fractions, vectors)
+
+
+def stuck_bit_modes(disc: BeamDiscretization, f_star_max: float, mass, stiffness) -> ModalBasis:
+    """Torsional modes of the string held by the drive and stuck at the bit (theta_x held at both ends):
+    the fixed-fixed waves n c_T / 2L that ring while the bit sticks (stick-slip, Section 6.9).  The modes of
+    the free bit alone reach the bit's stuck state only through many of them; with these, the basis
+    spans both phases, as the fixed-interface modes of Craig & Bampton (1968) with the static bit
+    responses of the guard as constraint modes."""
+    return _field_modes(disc, THETA_X, (0, 1), f_star_max, mass, stiffness, "torsional")
+
+
+def drive_held_modes(disc: BeamDiscretization, free: ModalBasis, f_star_max: float, mass, stiffness) -> ModalBasis:
+    """The modes of the band B with u and theta_x held at x = 0, as the drive holds them in a run (what
+    ``solve_modes(..., held=DRIVE)`` gives, without a second eigensolve of the whole string): holding them
+    leaves the flexural modes of the ``free`` string as they are, and the axial and torsional modes come
+    from their own blocks (:func:`_field_modes`)."""
+    flexural = free.select(np.flatnonzero(np.array(free.kinds) == "flexural"))
+    parts = [flexural, *(_field_modes(disc, field, (0,), f_star_max, mass, stiffness, kind)
+                         for field, kind in ((U, "axial"), (THETA_X, "torsional")))]
+    combined = ModalBasis(np.concatenate([part.frequencies_hz for part in parts]),
+                          np.concatenate([part.f_star for part in parts]),
+                          [kind for part in parts for kind in part.kinds],
+                          np.concatenate([part.energy_fractions for part in parts]),
+                          np.hstack([part.vectors for part in parts]))
+    return combined.select(np.argsort(combined.frequencies_hz, kind="stable"))
 
 
 def family_counts(kinds) -> dict[str, int]:

@@ -20,9 +20,8 @@ from fenics_drill.io.fields import FieldWriter
 from fenics_drill.io.files import write_json
 from fenics_drill.io.output_directory import claim_output
 from fenics_drill.io.timeseries import TimeSeriesWriter, read_series
-from fenics_drill.model.discretization import DRIVE
 from fenics_drill.model.drillstring import DrillstringModel
-from fenics_drill.model.modes import solve_modes
+from fenics_drill.model.modes import drive_held_modes
 from fenics_drill.model.resources import check_memory
 from fenics_drill.observables.drilling_quantities import drilling_quantities
 from fenics_drill.observables.step_rows import StepRows
@@ -86,7 +85,8 @@ class RunRecorder:
         self.on_write = on_write
         self.rows = StepRows(model, scene)
         self.section_x = self.rows.section_x
-        held = solve_modes(model.disc, scene.modal.f_star_max, model.operators.mass, held=DRIVE)
+        held = drive_held_modes(model.disc, model.modes, scene.modal.f_star_max, model.operators.mass,
+                                model.operators.stiffness)
         self.series = TimeSeriesWriter(out / "timeseries.h5", model.disc.vertex_x, {
             "section_x": self.section_x, "gap": model.gap, "scene": json.dumps(scene.to_dict()),
             "reduced_size": model.size,

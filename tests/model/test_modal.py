@@ -7,7 +7,7 @@ import pytest
 from conftest import scene_with
 
 from fenics_drill.model.discretization import DRIVE, BeamDiscretization
-from fenics_drill.model.modes import auto_bands, paper_bands, solve_modes, stuck_bit_modes
+from fenics_drill.model.modes import auto_bands, drive_held_modes, paper_bands, solve_modes, stuck_bit_modes
 from fenics_drill.model.operators import assemble_linear
 from fenics_drill.studies.modal_report import modal_report
 
@@ -99,6 +99,23 @@ def test_modes_held_by_the_drive_are_the_fixed_free_quarter_waves():
         np.testing.assert_allclose(f, (2 * n - 1) * c / (4 * p.length), rtol=5e-4)
     # the stick-slip line of Section 6.8: c_T / 4L = 7.276 Hz for the paper string; 0.01 Hz is the rounding of 7.28
     assert held.frequencies_hz[kinds == "torsional"][0] == pytest.approx(7.28, abs=0.01)
+
+
+def test_modes_held_by_the_drive_from_the_free_modes_and_two_blocks_are_the_whole_eigensolve():
+    """drive_held_modes (the free string's flexural modes, the axial and torsional blocks with u(0) and
+    theta_x(0) held) gives the eigensolve of the whole string held by the drive: the same kinds in the same
+    order and the same frequencies, to SLEPc's tolerance (1e-10 on the eigenpairs' residuals: 1e-8 on the
+    frequencies is well above it, and well below any discretization error), on a string with supports."""
+    scene = scene_with("beam.elements=60", "beam.length=30.0")
+    disc = BeamDiscretization.from_scene(scene)
+    operators = assemble_linear(disc)
+    assert len(disc.support_dofs) > 0
+    whole = solve_modes(disc, 3.0, operators.mass, held=DRIVE)
+    free = solve_modes(disc, 3.0, operators.mass)
+    held = drive_held_modes(disc, free, 3.0, operators.mass, operators.stiffness)
+    assert held.kinds == whole.kinds and {"flexural", "axial", "torsional"} <= set(held.kinds)
+    np.testing.assert_allclose(held.frequencies_hz, whole.frequencies_hz, rtol=1e-8)
+    np.testing.assert_allclose(held.vectors.T @ operators.mass @ held.vectors, np.eye(len(held)), atol=1e-9)
 
 
 def test_modes_of_a_stuck_bit_are_the_fixed_fixed_torsional_waves():
