@@ -16,10 +16,10 @@ import cffi
 import numpy as np
 from dolfinx import fem
 from llvmlite import ir
-from numba import types
+from numba import njit, types
 from numba.extending import intrinsic
 
-from fenics_drill.model.compiled import kernel
+from fenics_drill.model.compiled import REASSOCIATE, kernel
 
 _FFI = cffi.FFI()
 
@@ -37,12 +37,11 @@ def _call_at(typingctx, address, element, coefficients, constants, coordinates, 
     return signature, codegen
 
 
-@kernel
-def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, size, square):
-    """sum over the cells of their element tensors at the positions ``cell_dofs``: a vector of ``size``, or
+@njit(cache=True)
+def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, out):
+    """Add every cell's element tensor to ``out`` at the positions ``cell_dofs``: a vector of ``size``, or
     with ``square`` a (size x size) matrix, row-major (the element matrix's rows are its test functions)."""
     n = cell_dofs.shape[1]
-    out = np.zeros(size * size if square else size)
     element = np.empty(n * n if square else n)
     entity, permutation = np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
     for c in range(cell_dofs.shape[0]):
@@ -57,6 +56,31 @@ def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, si
         else:
             for k in range(n):
                 out[cell_dofs[c, k]] += element[k]
+
+
+@kernel
+def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, size, square):
+    """The sum of the cells' element tensors (:func:`_add_cells`) from their packed coefficients."""
+    out = np.zeros(size * size if square else size)
+    _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, out)
+    return out
+
+
+@kernel(fastmath=REASSOCIATE)
+def _assemble_cells_at(address, offset, rows, row_function, rows_map, state, constants, coordinates, cell_dofs, size,
+                       square):
+    """:func:`_assemble_cells` with the packed coefficients ``offset`` + the map of the reduced state: entry
+    ``rows[i]`` of the packed array is row i of ``rows_map`` times the reduced values of function
+    ``row_function[i]`` (the slice of ``state`` that stacks them)."""
+    packed = offset.copy()
+    n = rows_map.shape[1]
+    for i in range(rows.size):
+        start, value = row_function[i] * n, 0.0
+        for j in range(n):
+            value += rows_map[i, j] * state[start + j]
+        packed[rows[i]] += value
+    out = np.zeros(size * size if square else size)
+    _add_cells(address, packed.reshape(coordinates.shape[0], -1), constants, coordinates, cell_dofs, size, square, out)
     return out
 
 
@@ -129,10 +153,20 @@ class CellAssembly:
             self.size = len(dofs)
         self.constants = np.ascontiguousarray(fem.pack_constants(form), dtype=float)
 
-    def __call__(self, coefficients: np.ndarray):
-        """The assembled number, vector or matrix, from the cells' packed coefficients (cells x per cell)."""
-        out = _assemble_cells(self.address, np.ascontiguousarray(coefficients, dtype=float), self.constants,
-                              self.coordinates, self.cell_dofs, self.size, self.rank == 2)
+    def _shaped(self, out: np.ndarray):
         if self.rank == 0:
             return float(out[0])
         return out.reshape(self.size, self.size) if self.rank == 2 else out
+
+    def __call__(self, coefficients: np.ndarray):
+        """The assembled number, vector or matrix, from the cells' packed coefficients (cells x per cell)."""
+        return self._shaped(_assemble_cells(self.address, np.ascontiguousarray(coefficients, dtype=float),
+                                            self.constants, self.coordinates, self.cell_dofs, self.size,
+                                            self.rank == 2))
+
+    def at(self, offset, rows, row_function, rows_map, state):
+        """The same from the packed coefficients ``offset`` plus, at ``rows``, ``rows_map`` times the slice
+        ``row_function`` of ``state`` (the affine map of :class:`~fenics_drill.model.internal_force.SampledCoefficients`)."""
+        return self._shaped(_assemble_cells_at(self.address, offset, rows, row_function, rows_map, state,
+                                               self.constants, self.coordinates, self.cell_dofs, self.size,
+                                               self.rank == 2))

@@ -254,13 +254,20 @@ class SampledCoefficients:
                 function.x.array[dofs] = column
                 columns.append(fem.pack_coefficients(form)[key].ravel() - self.offset)
             function.x.array[:] = 0.0
-        self.map = np.ascontiguousarray(np.column_stack(columns))
+        # each packed entry is a dof of one function (or of none, as the weight): kept as the row of the map
+        # over that function's reduced values alone, a third of the map over the whole stacked state
+        by_function = np.column_stack(columns).reshape(len(self.offset), len(functions), len(phi_rows.T))
+        depends = np.abs(by_function).max(axis=2) != 0.0
+        if (depends.sum(axis=1) > 1).any():
+            raise ValueError("a packed coefficient depends on more than one function")
+        self.rows, self.row_function = np.nonzero(depends)
+        self.rows_map = np.ascontiguousarray(by_function[self.rows, self.row_function])
         self.cells = CellAssembly(form, dofs)
 
     def assemble(self, state: np.ndarray):
         """The assembled number, vector or matrix (at the sampled dofs) at the reduced state of the functions,
         stacked in one vector."""
-        return self.cells((self.offset + self.map @ state).reshape(self.shape))
+        return self.cells.at(self.offset, self.rows, self.row_function, self.rows_map, state)
 
 
 class TangentEntries:

@@ -154,11 +154,11 @@ class ModalSpace:
 
     @staticmethod
     def _factorise(tangent: np.ndarray, constraints: np.ndarray):
-        m = constraints.shape[0]
+        n, m = tangent.shape[0], constraints.shape[0]
         k = constraint_scale(tangent, constraints)
-        system = np.block([[tangent, k * constraints.T], [k * constraints, np.zeros((m, m))]])
-        factors = sla.lu_factor(system, check_finite=False)
-        n = tangent.shape[0]
+        system = np.zeros((n + m, n + m))
+        system[:n, :n], system[:n, n:], system[n:, :n] = tangent, k * constraints.T, k * constraints
+        factors = sla.lu_factor(system, overwrite_a=True, check_finite=False)
 
         def solve(rhs_q, rhs_c):
             x = sla.lu_solve(factors, np.concatenate([rhs_q, k * rhs_c]), check_finite=False)
