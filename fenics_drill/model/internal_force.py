@@ -15,6 +15,7 @@ so a change of step size needs no re-assembly.
 
 from __future__ import annotations
 
+import functools
 import weakref
 from dataclasses import dataclass
 
@@ -161,16 +162,32 @@ class AssembledInternalForce:
                                                                    operators.mass))
             self._linear_rows = np.hstack(self.linear)  # [K C M]: the linear part of (q, qd, qdd) stacked
             self.weight, self.phi_rows = forms.weight, space.phi[self.dofs]  # the sample's weight per cell
-            U, V, _ = forms.functions
-            self._packing = SampledCoefficients(self._residual, forms.functions, self.dofs, self.phi_rows)
-            self._tangent_cells = tuple(SampledCoefficients(form, forms.functions, self.dofs, self.phi_rows)
-                                        if form is not None else None for form in self._jacobians)
-            self._kinetic_cells = SampledCoefficients(self._kinetic, (U, V), self.dofs, self.phi_rows)
-            self._strain_cells = SampledCoefficients(self._strain, (U,), self.dofs, self.phi_rows)
         self._damping = space.project_matrix(operators.damping)  # (45) is linear: reused for the budget
         # (q, qd, qdd) of the last evaluation, set on the functions when a tangent needs it (other forces on
         # the same string share the functions, so a tangent never assumes they still hold this state)
         self._state = None
+
+    def _sampled(self, form: fem.Form, functions) -> "SampledCoefficients":
+        return SampledCoefficients(form, functions, self.dofs, self.phi_rows)
+
+    # the sampled forms' coefficient maps, built on first use (a trainer of the sample assembles through
+    # DOLFINx and never needs them)
+    @functools.cached_property
+    def _packing(self) -> "SampledCoefficients":
+        return self._sampled(self._residual, (self.U, self.V, self.A))
+
+    @functools.cached_property
+    def _tangent_cells(self) -> tuple:
+        return tuple(self._sampled(form, (self.U, self.V, self.A)) if form is not None else None
+                     for form in self._jacobians)
+
+    @functools.cached_property
+    def _kinetic_cells(self) -> "SampledCoefficients":
+        return self._sampled(self._kinetic, (self.U, self.V))
+
+    @functools.cached_property
+    def _strain_cells(self) -> "SampledCoefficients":
+        return self._sampled(self._strain, (self.U,))
 
     def _set(self, function: fem.Function, values: np.ndarray) -> None:
         if self.dofs is None:

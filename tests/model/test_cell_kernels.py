@@ -89,11 +89,12 @@ def test_cell_assembly_refuses_a_bilinear_form_of_two_spaces(sampled_forms):
 def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
     """In the default (modal) space, at 20 random states around the string's rest on the wall, the one-pass
     kernel gives (1) the positions and rates [Phi] q, [Phi] qd, (2) the pointwise law (16)-(19) at them and
-    (3) [Phi]^T of its loads.  It sums in another order than BLAS (reassociated, vectorised) and may fuse
-    multiply-adds, so each part is held to the round-off that allows, nothing looser:
+    (3) [Phi]^T of its loads, and of each law's loads.  It sums in another order than BLAS (reassociated,
+    vectorised) and may fuse multiply-adds, so each part is held to the round-off that allows, nothing looser:
 
     * a sum of n products in any order differs by at most n eps sum|terms| (Higham, Accuracy and Stability,
-      Sec. 3.1): the bound for (1) and (3), with n = 64 >= the 59 terms of a row or column;
+      Sec. 3.1): the bound for (1), with n = 64 >= the 59 terms of a row, and for (3), with n = the 4 rows
+      of each vertex (the terms of a column of [Phi]^T);
     * the law at the kernel's own positions, against the same law called from NumPy: fused multiply-adds
       change results by an ulp, and the indentation delta = |(v, w)| - gap cancels about 1e4 of its digits
       (delta ~ 1e-6 m against gap ~ 1e-2 m), so 1e-11 of the largest value."""
@@ -108,7 +109,8 @@ def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
     for _ in range(20):
         q = resting * (1 + 0.05 * rng.standard_normal(model.size))
         qd = rng.standard_normal(model.size) * 0.5
-        delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(flat, q, qd, *wall._law())
+        delta, nodal, laws, potential, generalised, lateral, rates, projected = _modal_pass(flat, q, qd,
+                                                                                            *wall._law())
         # (1) positions and rates
         position_bound = terms * eps * (np.abs(lateral_rows) @ np.abs(q)).reshape(-1, 2)
         rate_bound = terms * eps * (np.abs(flat) @ np.abs(qd)).reshape(-1, 4)
@@ -120,9 +122,13 @@ def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
         np.testing.assert_allclose(nodal, ref_nodal, rtol=0, atol=1e-11 * np.abs(ref_nodal).max())
         np.testing.assert_allclose(laws, ref_laws, rtol=0, atol=1e-11 * np.abs(ref_laws).max())
         assert potential == pytest.approx(ref_potential, rel=1e-11, abs=0.0)
-        # (3) the projection of the kernel's own loads
-        projection_bound = terms * eps * (np.abs(flat).T @ np.abs(nodal.ravel()))
+        # (3) the projection of the kernel's own loads, and of each law's (damper, axial friction, torque)
+        column_terms = flat.shape[0]
+        projection_bound = column_terms * eps * (np.abs(flat).T @ np.abs(nodal.ravel()))
         assert np.all(np.abs(generalised - flat.T @ nodal.ravel()) <= projection_bound)
+        by_law = laws.reshape(-1, 3)
+        law_bound = column_terms * eps * (np.abs(flat).T @ np.abs(by_law))
+        assert np.all(np.abs(projected.T - flat.T @ by_law) <= law_bound)
         touched += int((ref_delta > 0).sum())
     assert touched > 20  # the states reach the wall, so the loads are tested
 

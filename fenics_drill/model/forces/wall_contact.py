@@ -143,10 +143,13 @@ def _vertex_loads(lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_to
 def _modal_pass(flat, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s):
     """:func:`_vertex_loads` in a modal space, in one pass over the dense rows ``flat`` of [Phi]
     ((u, v, w, theta_x) of each vertex, interleaved): each vertex's positions and rates, its law, and
-    [Phi]^T of its nodal loads, while its four rows are in cache.  Also returns the positions and rates."""
+    [Phi]^T of its nodal loads, while its four rows are in cache; [Phi]^T of the loads of each law
+    (damper, axial friction, friction torque: rows of ``projected``) come with them.  Also returns the
+    positions and rates."""
     n, size = flat.shape[0] // 4, flat.shape[1]
     delta, nodal, laws = np.empty(n), np.zeros((n, 4)), np.zeros((n, 4, 3))
-    lateral, rates, generalised = np.empty((n, 2)), np.empty((n, 4)), np.zeros(size)
+    lateral, rates, projected = np.empty((n, 2)), np.empty((n, 4)), np.zeros((3, size))
+    lateral_loads = np.zeros(size)
     potential = 0.0
     for i in range(n):
         base = 4 * i
@@ -163,11 +166,15 @@ def _modal_pass(flat, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque,
         potential += _vertex_law(i, v, w, rates[i], gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh,
                                  v_s, delta, nodal, laws)
         if delta[i] > 0.0:
-            for f in range(4):
-                load = nodal[i, f]
-                for j in range(size):
-                    generalised[j] += flat[base + f, j] * load
-    return delta, nodal, laws, potential, generalised, lateral, rates
+            axial, load_v, load_w, torque = nodal[i, 0], nodal[i, 1], nodal[i, 2], nodal[i, 3]
+            damper_v, damper_w = laws[i, 1, 0], laws[i, 2, 0]
+            for j in range(size):
+                lateral_loads[j] += flat[base + 1, j] * load_v + flat[base + 2, j] * load_w
+                projected[0, j] += flat[base + 1, j] * damper_v + flat[base + 2, j] * damper_w
+                projected[1, j] += flat[base, j] * axial
+                projected[2, j] += flat[base + 3, j] * torque
+    generalised = lateral_loads + projected[1] + projected[2]
+    return delta, nodal, laws, potential, generalised, lateral, rates, projected
 
 
 @kernel
@@ -244,9 +251,9 @@ def _selection(rows: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
 
 
 class ProjectedLaws(Mapping):
-    """The generalised forces of the non-conservative wall laws (the damper of (17), (18), (19)),
-    projected on first use: the energy budget reads them at accepted steps only, not at Newton's
-    iterates."""
+    """The generalised forces of the non-conservative wall laws (the damper of (17), (18), (19)) in the full
+    space, projected on first use: the energy budget reads them at accepted steps only, not at Newton's
+    iterates (a modal space's pass projects them with the nodal loads, while the rows are in cache)."""
 
     NAMES = ("wall_damper", "wall_axial_friction", "wall_friction_torque")
 
@@ -428,11 +435,12 @@ class WallContact:
             rates = (vertex_set.flat @ qd).reshape(-1, len(FIELDS))
             delta, nodal, laws, potential = _vertex_loads(lateral, rates, *self._law())
             generalised = np.asarray(vertex_set.flat.T @ nodal.ravel())
+            by_law = ProjectedLaws(vertex_set.flat, laws)
         else:
-            delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(vertex_set.flat, q, qd,
-                                                                                     *self._law())
-        out = WallForces(generalised, potential, ProjectedLaws(vertex_set.flat, laws), len(self.x),
-                         vertex_set.vertices, delta, nodal)
+            delta, nodal, _, potential, generalised, lateral, rates, projected = _modal_pass(vertex_set.flat, q, qd,
+                                                                                             *self._law())
+            by_law = dict(zip(ProjectedLaws.NAMES, projected))
+        out = WallForces(generalised, potential, by_law, len(self.x), vertex_set.vertices, delta, nodal)
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
             out.tangent_data = (vertex_set.flat, lateral, rates)
         return out
