@@ -37,38 +37,65 @@ def _call_at(typingctx, address, element, coefficients, constants, coordinates, 
     return signature, codegen
 
 
-@njit(cache=True)
-def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, out):
-    """Add every cell's element tensor to ``out`` at the positions ``cell_dofs``: a vector of ``size``, or
-    with ``square`` a (size x size) matrix, row-major (the element matrix's rows are its test functions)."""
-    n = cell_dofs.shape[1]
+@njit(cache=True, fastmath=set(REASSOCIATE))
+def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, basis, out):
+    """Add every cell's element tensor to ``out``: at the positions ``cell_dofs`` (a vector of ``size``, or
+    with ``square`` a (size x size) matrix, row-major: the element matrix's rows are its test functions);
+    or, with a ``basis`` of N > 0 columns (the rows of [Phi] at the dofs), projected on it: P_c^T f_c, or
+    P_c^T K_c P_c (N x N) with P_c the basis rows of cell c's dofs."""
+    n, modes = cell_dofs.shape[1], basis.shape[1]
     element = np.empty(n * n if square else n)
+    work = np.empty((n, modes))
     entity, permutation = np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
     for c in range(cell_dofs.shape[0]):
         element[:] = 0.0
         _call_at(address, _FFI.from_buffer(element), _FFI.from_buffer(coefficients[c]), _FFI.from_buffer(constants),
                  _FFI.from_buffer(coordinates[c]), _FFI.from_buffer(entity), _FFI.from_buffer(permutation),
                  _FFI.from_buffer(permutation))
-        if square:
+        if modes == 0 and square:
             for k in range(n):
                 for m in range(n):
                     out[cell_dofs[c, k] * size + cell_dofs[c, m]] += element[k * n + m]
-        else:
+        elif modes == 0:
             for k in range(n):
                 out[cell_dofs[c, k]] += element[k]
+        elif square:
+            for k in range(n):  # K_c P_c
+                for j in range(modes):
+                    value = 0.0
+                    for m in range(n):
+                        value += element[k * n + m] * basis[cell_dofs[c, m], j]
+                    work[k, j] = value
+            for i in range(modes):  # P_c^T (K_c P_c)
+                for k in range(n):
+                    weight = basis[cell_dofs[c, k], i]
+                    for j in range(modes):
+                        out[i * modes + j] += weight * work[k, j]
+        else:
+            for k in range(n):
+                value, row = element[k], cell_dofs[c, k]
+                for j in range(modes):
+                    out[j] += value * basis[row, j]
+
+
+@njit(cache=True)
+def _zeros_for(size, square, basis):
+    """The output of :func:`_add_cells`: at the dofs, or projected on the basis's columns."""
+    m = basis.shape[1] if basis.shape[1] > 0 else size
+    return np.zeros(m * m if square else m)
 
 
 @kernel
-def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, size, square):
+def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, basis):
     """The sum of the cells' element tensors (:func:`_add_cells`) from their packed coefficients."""
-    out = np.zeros(size * size if square else size)
-    _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, out)
+    out = _zeros_for(size, square, basis)
+    _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, basis, out)
     return out
 
 
 @kernel(fastmath=REASSOCIATE)
 def _assemble_cells_at(address, offset, rows, row_function, rows_map, state, constants, coordinates, cell_dofs, size,
-                       square):
+                       square, basis):
     """:func:`_assemble_cells` with the packed coefficients ``offset`` + the map of the reduced state: entry
     ``rows[i]`` of the packed array is row i of ``rows_map`` times the reduced values of function
     ``row_function[i]`` (the slice of ``state`` that stacks them)."""
@@ -79,8 +106,9 @@ def _assemble_cells_at(address, offset, rows, row_function, rows_map, state, con
         for j in range(n):
             value += rows_map[i, j] * state[start + j]
         packed[rows[i]] += value
-    out = np.zeros(size * size if square else size)
-    _add_cells(address, packed.reshape(coordinates.shape[0], -1), constants, coordinates, cell_dofs, size, square, out)
+    out = _zeros_for(size, square, basis)
+    _add_cells(address, packed.reshape(coordinates.shape[0], -1), constants, coordinates, cell_dofs, size, square,
+               basis, out)
     return out
 
 
@@ -156,17 +184,24 @@ class CellAssembly:
     def _shaped(self, out: np.ndarray):
         if self.rank == 0:
             return float(out[0])
-        return out.reshape(self.size, self.size) if self.rank == 2 else out
+        if self.rank == 2:
+            side = int(round(np.sqrt(out.size)))
+            return out.reshape(side, side)
+        return out
 
     def __call__(self, coefficients: np.ndarray):
-        """The assembled number, vector or matrix, from the cells' packed coefficients (cells x per cell)."""
+        """The assembled number, vector or matrix at the dofs, from the cells' packed coefficients
+        (cells x per cell)."""
         return self._shaped(_assemble_cells(self.address, np.ascontiguousarray(coefficients, dtype=float),
                                             self.constants, self.coordinates, self.cell_dofs, self.size,
-                                            self.rank == 2))
+                                            self.rank == 2, np.empty((self.size, 0))))
 
-    def at(self, offset, rows, row_function, rows_map, state):
-        """The same from the packed coefficients ``offset`` plus, at ``rows``, ``rows_map`` times the slice
-        ``row_function`` of ``state`` (the affine map of :class:`~fenics_drill.model.internal_force.SampledCoefficients`)."""
+    def projected(self, offset, rows, row_function, rows_map, state, basis):
+        """The number, or the vector or matrix projected on ``basis`` (the rows of [Phi] at the dofs:
+        P^T f, P^T K P), from the packed coefficients ``offset`` plus, at ``rows``, ``rows_map`` times the
+        slice ``row_function`` of ``state`` (the affine map of
+        :class:`~fenics_drill.model.internal_force.SampledCoefficients`)."""
+        basis = basis if self.rank > 0 else np.empty((1, 0))  # a functional is a number: nothing to project
         return self._shaped(_assemble_cells_at(self.address, offset, rows, row_function, rows_map, state,
                                                self.constants, self.coordinates, self.cell_dofs, self.size,
-                                               self.rank == 2))
+                                               self.rank == 2, basis))

@@ -211,7 +211,7 @@ class AssembledInternalForce:
         if self.dofs is None:
             return self.space.project(self.assembled_vector(q, qd, qdd))
         state = np.concatenate((q, qd, qdd))
-        return self._linear_rows @ state + self.phi_rows.T @ self._packing.assemble(state)
+        return self._linear_rows @ state + self._packing.assemble(state)
 
     state_dependent = True
 
@@ -222,8 +222,7 @@ class AssembledInternalForce:
             return linear if linear is not None else self.space.zeros_matrix()
         if self.dofs is None:
             return self._matrices[k].assemble()
-        block = self._tangent_cells[k].assemble(np.concatenate(self._state))
-        return self.phi_rows.T @ (block @ self.phi_rows) + linear
+        return self._tangent_cells[k].assemble(np.concatenate(self._state)) + linear
 
     def tangent_parts(self, needed=(True, True, True)):
         """(df/dq, df/dqd, df/dqdd) at the state of the last :meth:`evaluate`; None for a part not
@@ -279,12 +278,13 @@ class SampledCoefficients:
             raise ValueError("a packed coefficient depends on more than one function")
         self.rows, self.row_function = np.nonzero(depends)
         self.rows_map = np.ascontiguousarray(by_function[self.rows, self.row_function])
+        self.basis = np.ascontiguousarray(phi_rows)
         self.cells = CellAssembly(form, dofs)
 
     def assemble(self, state: np.ndarray):
-        """The assembled number, vector or matrix (at the sampled dofs) at the reduced state of the functions,
-        stacked in one vector."""
-        return self.cells.at(self.offset, self.rows, self.row_function, self.rows_map, state)
+        """The assembled number, or the vector or matrix projected on [Phi] (cell by cell), at the reduced
+        state of the functions stacked in one vector."""
+        return self.cells.projected(self.offset, self.rows, self.row_function, self.rows_map, state, self.basis)
 
 
 class TangentEntries:
