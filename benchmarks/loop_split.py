@@ -85,9 +85,9 @@ def main() -> None:
             return run(self, state, t_end, recorded, progress)
         finally:
             SPENT["time loop"] += time.perf_counter() - clock
-            LAST_RUN.clear()  # the parts of this run alone (the main run comes after the training run)
+            LAST_RUN.clear()  # this run alone (the main run comes after the ECSW training run)
             LAST_RUN.update({label: (SPENT[label] - before[0][label], CALLS[label] - before[1][label])
-                             for _, _, label in PARTS})
+                             for label in ("Newton steps", *(label for _, _, label in PARTS))})
 
     time_loop.Simulation.run = timed_run
     scene = load_scene("demos/scenes/paper.toml", [f"time.t_end={sys.argv[1]}", "output.field_interval=0",
@@ -101,7 +101,7 @@ def main() -> None:
     for key, seconds in SPENT.most_common():
         if key not in parts:
             print(f"  {key:30s} {seconds:7.2f} s")
-    print("the model's parts in the main run's time loop:")
+    print("the main run's Newton steps and the model's parts in them:")
     for label, (seconds, calls) in LAST_RUN.items():
         if calls:
             print(f"  {label:30s} {seconds:7.2f} s {calls:7d} calls {1e6 * seconds / calls:7.0f} us")
