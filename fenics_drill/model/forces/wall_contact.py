@@ -448,7 +448,9 @@ class WallContact:
     def tangent(self, forces: WallForces, c_u: float, c_v: float):
         """c_u d f/dq + c_v d f/dqd of the generalised wall force (None without contact):
         sum over the vertices in contact of R_i^T A_i R_i, with R_i the four rows of [Phi] of
-        vertex i and A_i the 4 x 4 block of the pointwise derivatives."""
+        vertex i and A_i the 4 x 4 block of the pointwise derivatives.  In a modal space the product is
+        formed in single precision (half the cost of the step's largest product): the tangent only steers
+        Newton, and the residual, in double precision, decides when it has converged."""
         if forces.tangent_data is None:
             return None
         flat, lateral, rates = forces.tangent_data
