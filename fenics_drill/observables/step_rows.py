@@ -70,6 +70,8 @@ class StepRows:
         dv, dw, dsx = (float((rows @ s.qd)[0]) for rows in self.section_rows)
         stress, stress_x = self.stress.maximum(dofs) if self.stress is not None else (np.nan, np.nan)
         budget = record.budget
+        kinetic, strain, work, dissipated = (np.nan,) * 4 if budget is None else (
+            budget.kinetic, budget.strain, budget.input_work, budget.total_dissipated)
         force, torque = self.model.drive.applied(s.mu, record.evaluation.drive)
         top_velocity, top_spin = self.model.drive.velocities(s.qd)
         row = {
@@ -79,8 +81,7 @@ class StepRows:
             "top_angular_velocity": top_spin, "impacts": int(record.onsets.sum()),
             "section_v": v, "section_w": w, "section_v_velocity": dv, "section_w_velocity": dw,
             "section_theta_x_velocity": dsx, "max_von_mises": stress, "max_von_mises_x": stress_x,
-            "kinetic_energy": budget.kinetic, "strain_energy": budget.strain,
-            "input_work": budget.input_work, "dissipated_energy": budget.total_dissipated,
+            "kinetic_energy": kinetic, "strain_energy": strain, "input_work": work, "dissipated_energy": dissipated,
             **self.absent,
         }
         for force in self.model.forces:

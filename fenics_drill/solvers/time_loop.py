@@ -30,15 +30,18 @@ class StepRecord:
     evaluation: Evaluation
     onsets: np.ndarray  # vertices whose contact began during the step (bool per vertex)
     in_contact: np.ndarray  # vertices in contact at the end of the step
-    budget: EnergyBudget
+    budget: EnergyBudget | None  # None in a simulation that keeps no budget
     step_index: int
 
 
 class Simulation:
     """Integrates one scene's model from a given initial displacement."""
 
-    def __init__(self, model: DrillstringModel, scene):
+    def __init__(self, model: DrillstringModel, scene, energy_budget: bool = True):
+        """``energy_budget``: book the energy balance of every step (a run's summary reports it; a study
+        that reads none of it, a Monte Carlo realisation, saves its cost)."""
         model = model.fresh()  # its own cut surface and controller memory
+        self.keeps_budget = energy_budget
         self.model, self.scene = model, scene
         solver = scene.solver
         self.stepper = NewmarkNewton(model, scene.time.newmark_alpha, solver.newton_tolerance,
@@ -106,10 +109,12 @@ class Simulation:
         model = self.model
         ev = model.evaluate(state.q, state.qd, state.qdd, state.mu)
         h0 = model.constraints @ state.q - model.drive_rate * state.t
-        budget = EnergyBudget(initial_energy=sum(self.mechanical_energy(state, ev)))
-        budget.record(*self.mechanical_energy(state, ev))
+        budget = powers = None
+        if self.keeps_budget:
+            budget = EnergyBudget(initial_energy=sum(self.mechanical_energy(state, ev)))
+            budget.record(*self.mechanical_energy(state, ev))
+            powers = self._power_terms(state, ev)
         self.budget = budget
-        powers = self._power_terms(state, ev)
         in_contact = self._contact(ev, np.zeros(len(self.impacts_per_vertex), bool))
         clock = time.perf_counter()
         self.last_state = state
@@ -130,9 +135,11 @@ class Simulation:
                 self.stats["rejected_steps"] += 1
                 continue
             model.accept(new.t, new.q, new.qd)
-            new_powers = self._power_terms(new, new_ev)
-            budget.advance(powers, new_powers, new.q - state.q)
-            budget.record(*self.mechanical_energy(new, new_ev))
+            new_powers = None
+            if budget is not None:
+                new_powers = self._power_terms(new, new_ev)
+                budget.advance(powers, new_powers, new.q - state.q)
+                budget.record(*self.mechanical_energy(new, new_ev))
             new_contact = self._contact(new_ev, in_contact)
             onsets = new_contact & ~in_contact
             self.impacts_per_vertex += onsets

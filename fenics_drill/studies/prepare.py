@@ -142,7 +142,7 @@ def run_realisation(prepared: PreparedScene, scene) -> dict:
     and the scalars of a realisation."""
     model = prepared.model.with_drive(scene.drive.axial_velocity, scene.drive.rotation_speed) \
         .with_bit_rock(scene.bit_rock)
-    simulation = Simulation(model, scene)
+    simulation = Simulation(model, scene, energy_budget=False)  # no output of a realisation reads the budget
     start = simulation.initial_state(prepared.equilibrium.q)
     recorder = RealisationRecorder(model, scene)
     clock = time.perf_counter()
