@@ -263,7 +263,7 @@ class SampledCoefficients:
         for function in functions:
             function.x.array[:] = 0.0
         (key, packed), = fem.pack_coefficients(form).items()
-        self.shape, self.offset = packed.shape, packed.ravel().copy()
+        self.offset = packed.ravel().copy()
         columns = []
         for function in functions:
             for column in phi_rows.T:

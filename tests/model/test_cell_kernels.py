@@ -66,6 +66,8 @@ def test_the_cells_kernels_give_dolfinx_assembly_of_the_sampled_tangents_and_ene
             reference = fem.assemble_matrix(jacobian).to_dense()
             ours = CellAssembly(jacobian, forms.dofs)(packed)
             assert np.abs(reference).max() > 0
+            # the same element matrices added in another order: an entry sums at most two cells' values,
+            # so a few ulps of the largest entry; 1e-13 is about 500 eps
             np.testing.assert_allclose(ours, reference[np.ix_(forms.dofs, forms.dofs)], rtol=0,
                                        atol=1e-13 * np.abs(reference).max())
             untouched = np.ones(reference.shape, dtype=bool)
@@ -75,6 +77,7 @@ def test_the_cells_kernels_give_dolfinx_assembly_of_the_sampled_tangents_and_ene
             (key, packed), = fem.pack_coefficients(energy).items()
             reference = fem.assemble_scalar(energy)
             assert reference != 0.0
+            # the same four cell integrals summed in another order: a few ulps of the sum
             assert CellAssembly(energy)(packed) == pytest.approx(reference, rel=1e-13, abs=0.0)
 
 
@@ -99,6 +102,8 @@ def test_the_sampled_forms_projected_cell_by_cell_are_the_projections_of_their_a
         reference = basis.T @ at_dofs if at_dofs.ndim == 1 else basis.T @ at_dofs @ basis
         ours = coefficients.assemble(state)
         assert np.abs(reference).max() > 0
+        # projected cell by cell instead of after assembly: sums of up to 15 x 15 x 4 products per entry in
+        # another order (Higham: n eps ~ 2e-13 of the sum of magnitudes), so 1e-12 of the largest entry
         np.testing.assert_allclose(ours, reference, rtol=0, atol=1e-12 * np.abs(reference).max())
 
 
@@ -117,8 +122,8 @@ def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
     vectorised) and may fuse multiply-adds, so each part is held to the round-off that allows, nothing looser:
 
     * a sum of n products in any order differs by at most n eps sum|terms| (Higham, Accuracy and Stability,
-      Sec. 3.1): the bound for (1), with n = 64 >= the 59 terms of a row, and for (3), with n = the 4 rows
-      of each vertex (the terms of a column of [Phi]^T);
+      Sec. 3.1): the bound for (1), with n = 64 >= the 59 terms of a row, and for (3), with n = 4 rows per
+      vertex times the vertices (the terms of a column of [Phi]^T);
     * the law at the kernel's own positions, against the same law called from NumPy: fused multiply-adds
       change results by an ulp, and the indentation delta = |(v, w)| - gap cancels about 1e4 of its digits
       (delta ~ 1e-6 m against gap ~ 1e-2 m), so 1e-11 of the largest value."""
