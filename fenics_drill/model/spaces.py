@@ -18,6 +18,8 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.linalg.lapack import dgetrf as getrf
+from scipy.linalg.lapack import dgetrs as getrs
 
 from fenics_drill.model.banded_saddle import BandedSaddle
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
@@ -154,14 +156,21 @@ class ModalSpace:
 
     @staticmethod
     def _factorise(tangent: np.ndarray, constraints: np.ndarray):
+        """LAPACK's getrf/getrs called directly: SciPy's lu_factor/lu_solve check and look up LAPACK at every
+        call, which costs ten times the solve of a small system (a Newton iterate makes several)."""
         n, m = tangent.shape[0], constraints.shape[0]
         k = constraint_scale(tangent, constraints)
-        system = np.zeros((n + m, n + m))
-        system[:n, :n], system[:n, n:], system[n:, :n] = tangent, k * constraints.T, k * constraints
-        factors = sla.lu_factor(system, overwrite_a=True, check_finite=False)
+        system = np.empty((n + m, n + m), order="F")  # LAPACK's order: factorised in place, no copy
+        system[:n, :n], system[:n, n:], system[n:, :n], system[n:, n:] = tangent, k * constraints.T, k * constraints, 0.0
+        factors, pivots, info = getrf(system, overwrite_a=True)
+        if info < 0:
+            raise ValueError(f"getrf: argument {-info} is invalid")
+        # info > 0: an exactly singular system; the solve gives non-finite values, which Newton reports
+        rhs = np.empty(n + m)
 
         def solve(rhs_q, rhs_c):
-            x = sla.lu_solve(factors, np.concatenate([rhs_q, k * rhs_c]), check_finite=False)
+            rhs[:n], rhs[n:] = rhs_q, k * rhs_c
+            x, _ = getrs(factors, pivots, rhs)
             return x[:n], k * x[n:]
 
         return solve

@@ -202,7 +202,7 @@ def test_the_wall_tangent_of_a_modal_space_is_its_double_precision_product_to_si
         qd = rng.standard_normal(model.size) * 0.5
         forces = wall.evaluate(q, qd, with_tangent=True)
         c_u, c_v = 1.0, 1e3
-        tangent = wall.tangent(forces, c_u, c_v)
+        tangent = wall.fresh().tangent(forces, c_u, c_v)  # formed whole (no kept tangent to update)
         flat, lateral, rates = forces.tangent_data
         active = np.flatnonzero(forces.delta > 0)
         blocks = _contact_blocks(active, lateral, rates, *wall._law(), c_u, c_v)
@@ -214,3 +214,50 @@ def test_the_wall_tangent_of_a_modal_space_is_its_double_precision_product_to_si
         assert np.all(np.abs(tangent - reference) <= bound)
         assert np.any(np.abs(tangent + 1e-4 * np.abs(reference).max() - reference) > bound)
         assert np.abs(reference).max() > 0
+
+
+def test_the_updated_wall_tangent_is_the_exact_one_within_its_block_tolerance():
+    """A simulation's wall keeps its modal tangent and adds R_i^T (A_i - A_i_kept) R_i only at the vertices
+    whose block A_i moved by more than tau = BLOCK_TOLERANCE of the largest block s.  Along 30 states that
+    drift as a step's Newton iterates and steps do (with one change of c_v, as after a change of step), each
+    tangent is within the bound that rule gives against R^T A R in double precision:
+
+        tau s sum_i |R_i|^T 1 |R_i|     (each kept entry off by at most tau s; 1: the 4 x 4 ones)
+      + U (k + 2) u sum_i |R_i|^T 2 M_i |R_i|   (the single-precision round-off of the U updates so far,
+                                                 each increment bounded by 2 M_i, M_i the largest |A_i| seen)
+
+    A tangent kept from five states earlier breaks that bound at most states, so the test can fail."""
+    scene = scene_with(*STRING)
+    model = prepare(scene, dynamics=False).model
+    resting = solve_static(model).q
+    wall = model.force("wall").fresh()
+    tau = wall.BLOCK_TOLERANCE
+    rng = np.random.default_rng(7)
+    u = np.finfo(np.float32).eps / 2
+    radius = np.sort(np.hypot(*(rows @ resting for rows in model.lateral_rows)))
+    q = resting * 1.03 * model.gap / radius[-3]  # three or more vertices pressed into the wall
+    qd = rng.standard_normal(model.size) * 0.05
+    rows = wall.flat.reshape(-1, 4, model.size)  # (vertex, field, column) of every vertex
+    largest = np.zeros((rows.shape[0], 4, 4))  # M_i
+    history, stale_breaks = [], 0
+    for state in range(30):
+        q = q + 2e-4 * np.abs(q).max() * rng.standard_normal(model.size)
+        qd = qd + 0.01 * rng.standard_normal(model.size)
+        c_u, c_v = 1.0, (1e3 if state < 15 else 2e3)
+        forces = wall.evaluate(q, qd, with_tangent=True)
+        tangent = wall.tangent(forces, c_u, c_v)
+        flat, lateral, rates = forces.tangent_data
+        active = np.flatnonzero(forces.delta > 0)
+        blocks = np.zeros_like(largest)
+        blocks[forces.vertices[active]] = _contact_blocks(active, lateral, rates, *wall._law(), c_u, c_v)
+        largest = np.maximum(largest, np.abs(blocks))
+        reference = np.einsum("voi,vof,vfj->ij", rows, blocks, rows)
+        kept_off = tau * largest.max() * np.einsum("voi,vfj->ij", np.abs(rows), np.abs(rows))
+        updates = state + 1
+        round_off = updates * (4 * rows.shape[0] + 2) * u * np.einsum("voi,vof,vfj->ij", np.abs(rows), 2 * largest,
+                                                                        np.abs(rows))
+        assert np.all(np.abs(tangent - reference) <= kept_off + round_off)
+        history.append(tangent)
+        if state >= 5:
+            stale_breaks += np.any(np.abs(history[-6] - reference) > kept_off + round_off)
+    assert stale_breaks >= 20

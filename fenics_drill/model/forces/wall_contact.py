@@ -238,6 +238,28 @@ def _weighted_rows(flat, active, blocks):
     return transposed, weighted
 
 
+@kernel
+def _moved_blocks(vertices, blocks, kept, tolerance):
+    """The vertices whose block moved by more than ``tolerance`` times the largest block, (vertex, field,
+    field) ``kept`` against the ``blocks`` of the ``vertices`` in contact (zero elsewhere): their indices,
+    the increments of their blocks, and the kept blocks with theirs replaced."""
+    current = np.zeros_like(kept)
+    for k in range(vertices.size):
+        current[vertices[k]] = blocks[k]
+    scale = max(np.abs(current).max(), np.abs(kept).max())
+    moved = np.zeros(kept.shape[0], dtype=np.bool_)
+    for i in range(kept.shape[0]):
+        moved[i] = np.abs(current[i] - kept[i]).max() > tolerance * scale
+    changed = np.flatnonzero(moved)
+    increments = np.empty((changed.size, kept.shape[1], kept.shape[2]))
+    updated = kept.copy()
+    for k in range(changed.size):
+        i = changed[k]
+        increments[k] = current[i] - kept[i]
+        updated[i] = current[i]
+    return changed, increments, updated
+
+
 def _selection(rows: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
     """(column, value) of each row of a full space's [Phi] rows, which hold one entry or none (a dof held by
     a support: column -1, value 0)."""
@@ -377,6 +399,7 @@ class WallContact:
         self._column_sizes = abs(lateral_rows[0::2]) + abs(lateral_rows[1::2])
         self.culling = culling
         self._near = None  # the VertexSet of the last culled evaluation
+        self._kept_tangent = None  # (matrix, blocks, updates) of the modal tangent (:meth:`_updated_tangent`)
 
     @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "WallContact":
@@ -389,7 +412,14 @@ class WallContact:
         """A copy whose wall springs k_FS1, k_FS2 are scaled by ``factor`` (the static continuation)."""
         scaled = copy.copy(self)
         scaled.k1, scaled.k2 = factor * self.k1, factor * self.k2
+        scaled._kept_tangent = None
         return scaled
+
+    def fresh(self) -> "WallContact":
+        """A copy whose modal tangent is formed afresh (a simulation's results never depend on another's)."""
+        changed = copy.copy(self)
+        changed._kept_tangent = None
+        return changed
 
     def record(self, forces: "WallForces") -> dict[str, float]:
         return {"vertices_in_contact": int(forces.in_contact.sum())}
@@ -466,5 +496,39 @@ class WallContact:
             data = scale[:, :, None] * blocks * scale[:, None, :]
             kept = (rows >= 0) & (columns >= 0) & (data != 0.0)
             return sp.coo_matrix((data[kept], (rows[kept], columns[kept])), shape=(flat.shape[1],) * 2)
-        transposed, weighted = _weighted_rows(flat, active, blocks)
-        return (transposed @ weighted).astype(float)
+        return self._updated_tangent(forces.vertices[active], blocks)
+
+    #: A vertex's block enters the modal tangent afresh when it changed by more than this share of the largest
+    #: block since it last did; the tangent then differs from the exact one by less than that share of the
+    #: largest block at each vertex (Newton's residual, exact, still decides convergence).
+    BLOCK_TOLERANCE = 1e-4
+    #: Updates of the kept tangent after which it is formed whole again: each adds the single-precision
+    #: round-off of its own product, and this bounds their sum.
+    UPDATES_BEFORE_REFORMING = 100
+
+    def _updated_tangent(self, vertices: np.ndarray, blocks: np.ndarray) -> np.ndarray:
+        """sum_i R_i^T A_i R_i in a modal space, with the blocks A_i of the vertices in contact, as an update
+        of the last tangent formed: R_i^T (A_i - A_i_kept) R_i is added for the vertices whose block moved by
+        more than BLOCK_TOLERANCE of the largest one, and the others keep theirs.  In steady contact a step's
+        tangent changes at a fraction of the vertices, and so costs a fraction of the whole product; where
+        most blocks moved it is formed whole."""
+        kept = self._kept_tangent
+        if kept is None or kept[2] >= self.UPDATES_BEFORE_REFORMING:
+            size = self.flat.shape[1]
+            kept = (np.zeros((size, size)), np.zeros((len(self.x), len(FIELDS), len(FIELDS))), 0)
+            tolerance = 0.0  # every block in contact enters
+        else:
+            tolerance = self.BLOCK_TOLERANCE
+        matrix, kept_blocks, updates = kept
+        changed, increments, moved_blocks = _moved_blocks(vertices, blocks, kept_blocks, tolerance)
+        if updates and 2 * changed.size > vertices.size:
+            # most blocks moved (a change of step, contact lost): formed whole, as cheap, and without the
+            # round-off of larger blocks that an update would leave in a smaller tangent
+            self._kept_tangent = None
+            return self._updated_tangent(vertices, blocks)
+        kept_blocks = moved_blocks
+        if changed.size:
+            transposed, weighted = _weighted_rows(self.flat, changed, increments)
+            matrix = matrix + (transposed @ weighted).astype(float)
+        self._kept_tangent = (matrix, kept_blocks, updates + 1)
+        return matrix
