@@ -143,6 +143,8 @@ class TopDrive:
 
     def evaluate(self, q: np.ndarray, qd: np.ndarray) -> DriveLoads:
         """The applied weight on bit and motor torque at (q, qd) at the time of the step being solved."""
+        if self.held.all():  # the multipliers carry all the drive's loads
+            return DriveLoads(np.zeros(len(q)), 0.0, 0.0)
         force = 0.0 if self.held[AXIAL] else self.weight_on_bit
         torque = d_angle = d_speed = 0.0
         if not self.held[ROTATION]:

@@ -10,6 +10,7 @@ residual norm decreases stops that.  What counts as converged is the caller's.
 
 from __future__ import annotations
 
+import math
 from typing import Callable
 
 import numpy as np
@@ -50,7 +51,7 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
     law along it (None if there is none before the full update): the line search's second trial.
     Returns None when ``max_iterations`` updates did not satisfy ``check``.
     """
-    norm = np.linalg.norm(evaluation.residual)
+    norm = math.sqrt(evaluation.residual @ evaluation.residual)
     tangent = None
     for iteration in range(1, max_iterations + 1):
         gap = constraints @ q - target
@@ -63,7 +64,7 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
 
         def trial(step):
             result = evaluate(q + step * dq, mu + step * dmu)
-            return np.linalg.norm(result.residual), result
+            return math.sqrt(result.residual @ result.residual), result
 
         previous = norm
         kink = kink_step(evaluation, dq) if kink_step is not None else None
