@@ -56,6 +56,11 @@ class ModalPointRows:
         """P^T f: the generalised force of point forces f on the dofs."""
         return self.matrix.T @ point_values
 
+    def unit_loads(self) -> tuple[np.ndarray, ...]:
+        """P^T e_k of each dof k: the generalised force of a unit load on it (a point law's load is a
+        multiple of it, cheaper than a product)."""
+        return tuple(self.matrix.copy())
+
     def block(self, jacobian: np.ndarray) -> np.ndarray:
         """P^T A P: the tangent of a point law with Jacobian A (k x k) on the dofs."""
         return self.matrix.T @ jacobian @ self.matrix
@@ -82,6 +87,9 @@ class SelectedPointRows:
         out = np.zeros(self.size)
         np.add.at(out, self.positions[self.free], np.asarray(point_values, dtype=float)[self.free])
         return out
+
+    def unit_loads(self) -> tuple[np.ndarray, ...]:
+        return tuple(self.spread(unit) for unit in np.eye(self.positions.size))
 
     def block(self, jacobian: np.ndarray) -> sp.coo_matrix:
         kept = np.flatnonzero(self.free)

@@ -5,6 +5,7 @@ realisation keeps.  :data:`VARIABLES` names them with their units; the point for
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
 from fenics_drill.model.discretization import THETA_X
 from fenics_drill.model.drillstring import DrillstringModel
@@ -56,7 +57,9 @@ class StepRows:
         self.section_x = float(disc.vertex_x[section])
         v_rows, w_rows = model.lateral_rows
         tx_rows = model.space.rows(disc.vertex_dofs(THETA_X))
-        self.section_rows = (v_rows[[section]], w_rows[[section]], tx_rows[[section]])
+        # u(L), theta_x(L), then v, w, theta_x at the section: one product gives them all
+        parts = (model.bit_rows, v_rows[[section]], w_rows[[section]], tx_rows[[section]])
+        self.point_rows = sp.vstack(parts, format="csr") if sp.issparse(parts[0]) else np.vstack(parts)
         flags = scene.model
         self.stress = VonMisesProbe(disc, flags.geometric_nonlinearity, flags.kinematics) \
             if scene.output.von_mises else None
@@ -65,9 +68,8 @@ class StepRows:
     def __call__(self, record: StepRecord, dofs: np.ndarray) -> dict:
         """The row of one step; ``dofs`` is the full-space displacement Phi q of the step."""
         s = record.state
-        u, du, tx, dtx = self.model.bit_state(s.q, s.qd)
-        v, w, _ = (float((rows @ s.q)[0]) for rows in self.section_rows)
-        dv, dw, dsx = (float((rows @ s.qd)[0]) for rows in self.section_rows)
+        u, tx, v, w, _ = (self.point_rows @ s.q).tolist()
+        du, dtx, dv, dw, dsx = (self.point_rows @ s.qd).tolist()
         stress, stress_x = self.stress.maximum(dofs) if self.stress is not None else (np.nan, np.nan)
         budget = record.budget
         kinetic, strain, work, dissipated = (np.nan,) * 4 if budget is None else (

@@ -123,6 +123,8 @@ class BitRock:
         consistent torque (21), -1 for the torque as printed (mu_BR -> -mu_BR, since F_BR <= 0)."""
         self.torque_sign = torque_sign
         self.rows = space.point_rows([disc.end_dof(U, 1), disc.end_dof(THETA_X, 1)])  # q -> u(L), theta_x(L)
+        # P^T of a unit force on u(L) and of a unit torque on theta_x(L): the laws' loads are multiples of them
+        self._unit_loads = self.rows.unit_loads()
         self.limit_force, self.rate = bit_rock.limit_force, bit_rock.rate
         self.friction, self.borehole_radius = torque_sign * bit_rock.friction, borehole_radius
 
@@ -148,8 +150,7 @@ class BitRock:
         u_dot, omega = self.rows.values(qd).tolist()
         force, torque, d_force, d_torque_velocity, d_torque_spin = _law(
             u_dot, omega, self.limit_force, self.rate, self.friction, self.borehole_radius)
-        laws = {"bit_rock_force": self.rows.spread(np.array([force, 0.0])),
-                "bit_rock_torque": self.rows.spread(np.array([0.0, torque]))}
+        laws = {"bit_rock_force": force * self._unit_loads[0], "bit_rock_torque": torque * self._unit_loads[1]}
         generalised = laws["bit_rock_force"] + laws["bit_rock_torque"]
         return BitForces(generalised, 0.0, laws, u_dot, omega, force, torque, d_force, d_torque_velocity,
                          d_torque_spin)

@@ -135,6 +135,7 @@ class CuttingBit:
 
     def __init__(self, disc: BeamDiscretization, space, bit_rock, drive):
         self.rows = space.point_rows([disc.end_dof(U, 1), disc.end_dof(THETA_X, 1)])  # q -> u(L), theta_x(L)
+        self._unit_loads = self.rows.unit_loads()  # P^T of a unit force on u(L) and a unit torque on theta_x(L)
         self._set_parameters(bit_rock)
         self.feed_per_radian = drive.axial_velocity / drive.rotation_speed if drive.rotation_speed > 0 else 0.0
         self.surface: CutSurface | None = None  # no rock cut before the drilling run begins
@@ -217,8 +218,7 @@ class CuttingBit:
         jac_qd = -np.array([[d_contact_v, 0.0],
                             [self.contact_torque_arm * d_contact_v * s, magnitude * ds / self.spin_scale]])
         f_u, f_t = -weight, -torque
-        laws = {"bit_rock_force": self.rows.spread(np.array([f_u, 0.0])),
-                "bit_rock_torque": self.rows.spread(np.array([0.0, f_t]))}
+        laws = {"bit_rock_force": f_u * self._unit_loads[0], "bit_rock_torque": f_t * self._unit_loads[1]}
         generalised = laws["bit_rock_force"] + laws["bit_rock_torque"]
         return CuttingForces(generalised, 0.0, laws, d, f_u, f_t, jac_q, jac_qd)
 
