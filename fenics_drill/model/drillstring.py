@@ -207,15 +207,19 @@ class DrillstringModel:
         those with a non-zero coefficient.
         The point forces' tangents are always fresh.
         """
-        internal = self.internal.evaluate(q, qd, qdd) + self.drive.inertia_force(qdd)
+        internal = self.internal.evaluate(q, qd, qdd)
+        if self.drive.inertia:
+            internal = internal + self.drive.inertia_force(qdd)
         drive = self.drive.evaluate(q, qd)
         external = drive.generalised.copy()
         want = tangent_coefficients is not None
         evaluations = {}
         for force in self.forces:
-            evaluations[force.name] = force.evaluate(q, qd, with_tangent=want)
-            external += evaluations[force.name].generalised
-        residual = internal - external + self.constraints.T @ mu
+            evaluation = evaluations[force.name] = force.evaluate(q, qd, with_tangent=want)
+            external += evaluation.generalised
+        residual = internal - external
+        if mu.size:
+            residual += self.constraints.T @ mu
         out = Evaluation(residual, internal, external, evaluations, drive)
         if want:
             needed = tuple(c != 0 for c in tangent_coefficients)

@@ -21,17 +21,19 @@ HALVINGS = 6
 ARMIJO = 1e-4
 
 
-def backtrack(trial, norm0: float, step: float = 1.0, kink: float | None = None):
+def backtrack(trial, norm0: float, step: float = 1.0, kink=None):
     """Largest step = step / 2^k (k < HALVINGS) whose ``trial(step) -> (norm, payload)`` decreases
     the norm enough; returns (step, norm, payload) of the accepted (or last) trial.
 
-    ``kink``: the step just past the first kink of a force law along the update (a branch the tangent
-    did not see).  When the first trial fails, the kink is tried next and the halving goes on from it."""
+    ``kink()``: the step just past the first kink of a force law along the update (a branch the tangent
+    did not see), or None; asked only when the first trial fails, it is tried next and the halving goes
+    on from it."""
     for attempt in range(HALVINGS):
         norm, payload = trial(step)
         if norm < (1.0 - ARMIJO * step) * norm0:
             break
-        step = kink if attempt == 0 and kink is not None and kink < step else 0.5 * step
+        past = kink() if attempt == 0 and kink is not None else None
+        step = past if past is not None and past < step else 0.5 * step
     return step, norm, payload
 
 
@@ -63,13 +65,14 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
         dq, dmu = space.saddle_solve(tangent, constraints, -evaluation.residual, -gap)
 
         def trial(step):
-            result = evaluate(q + step * dq, mu + step * dmu)
-            return math.sqrt(result.residual @ result.residual), result
+            point = (q + dq, mu + dmu) if step == 1.0 else (q + step * dq, mu + step * dmu)
+            result = evaluate(*point)
+            return math.sqrt(result.residual @ result.residual), (point, result)
 
-        previous = norm
-        kink = kink_step(evaluation, dq) if kink_step is not None else None
-        step, norm, evaluation = backtrack(trial, norm, 1.0 if first_step is None else first_step(dq), kink)
-        q, mu = q + step * dq, mu + step * dmu
+        previous, at = norm, evaluation
+        kink = (lambda: kink_step(at, dq)) if kink_step is not None else None
+        step, norm, ((q, mu), evaluation) = backtrack(trial, norm, 1.0 if first_step is None else first_step(dq),
+                                                     kink)
         if step < 1.0 or norm > reuse_rate * previous:
             tangent = None
     return None

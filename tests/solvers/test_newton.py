@@ -46,9 +46,34 @@ def test_the_line_search_tries_the_step_just_past_a_kink_and_then_converges_on_t
     # from y = -1 the unit spring's update overshoots to y = b, the kink trial lands just past y = 0, and
     # the next update on the stiff branch (linear) is exact: converged at the third check, after three trials
     assert updates == 3 and evaluations == 3
-    # halving alone lands ever nearer the kink from either side, with the tangent of the side it left
-    plain, _ = solve(with_kink=False)
-    assert plain is None
+    # halving alone creeps towards the kink with the soft side's tangent: from y = 0 all six halvings fail
+    # (the last lands at y = 1/32, on the stiff side), and only then does the stiff branch's tangent take it
+    # to the root: three times the evaluations
+    (plain_root, plain_updates), plain_evaluations = solve(with_kink=False)
+    assert plain_root == pytest.approx(LOAD / (1 + STIFF), rel=1e-12)
+    assert plain_evaluations == 9 and plain_updates == 4
+
+
+def test_when_every_halving_fails_newton_goes_on_from_the_last_point_it_evaluated():
+    """After HALVINGS failed trials the iterate is the last trial's point, whose residual and tangent the next
+    update uses (not a further halved point that was never evaluated)."""
+    points = [0.0]  # the initial point, evaluated by the caller
+
+    def evaluate(y, mu):
+        points.append(y[0])
+        return Kinked(y)
+
+    def check(iteration, y, mu, ev, norm, gap):
+        # each checked iterate is a point Newton evaluated, with that point's residual
+        assert y[0] in points and ev.y == y[0]
+        return (y[0], iteration) if norm <= 1e-12 * LOAD else None
+
+    y0 = np.array([0.0])
+    result = saddle_newton(evaluate, ModalSpace(np.eye(1)), np.zeros((0, 1)), np.zeros(0), y0, np.zeros(0),
+                           Kinked(y0), check, 40)
+    # from y = 0 the six halvings of the soft side's update all fail; the stiff side's tangent at the last
+    # one (y = 1/32) then gives the root, which the consistent iterate reaches
+    assert result is not None and 1.0 / 32.0 in points
 
 
 @pytest.mark.parametrize("value, change", [(-1.0, 3.0), (2.0, -2.5), (1e-6, -1.0)])
