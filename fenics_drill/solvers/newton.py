@@ -45,8 +45,9 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
 
     ``evaluate(q, mu)`` evaluates a trial state.  Before each update
     ``check(iteration, q, mu, evaluation, norm, gap)`` returns the result to stop with,
-    or None to go on (it may raise).  ``first_step(dq)`` caps the first trial step of the
-    line search (default 1).  With ``reuse_rate`` > 0 the tangent of an earlier iterate is kept
+    or None to go on (it may raise).  ``first_step(dq)`` limits the move of an update (default 1: none);
+    a limited update is taken without the line search, as a trust region's step: far from the solution
+    (a straight string falling onto the wall) the residual need not decrease along it.  With ``reuse_rate`` > 0 the tangent of an earlier iterate is kept
     while each full update shrinks the residual norm at least by that factor (a modified Newton with a
     convergence-rate test; Deuflhard 2004, Sec. 2.1); a slower or damped update takes a fresh one.
     ``kink_step(evaluation, dq)`` gives the fraction of an update just past the first kink of a force
@@ -71,8 +72,11 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
 
         previous, at = norm, evaluation
         kink = (lambda: kink_step(at, dq)) if kink_step is not None else None
-        step, norm, ((q, mu), evaluation) = backtrack(trial, norm, 1.0 if first_step is None else first_step(dq),
-                                                     kink)
+        limit = 1.0 if first_step is None else first_step(dq)
+        if limit < 1.0:  # a move-limited step is taken as it is (see the docstring)
+            step, (norm, ((q, mu), evaluation)) = limit, trial(limit)
+        else:
+            step, norm, ((q, mu), evaluation) = backtrack(trial, norm, 1.0, kink)
         if step < 1.0 or norm > reuse_rate * previous:
             tangent = None
     return None
