@@ -93,7 +93,9 @@ def _solve_eps(K: PETSc.Mat, M: PETSc.Mat, nev: int, target: float) -> SLEPc.EPS
     eps.setOperators(K, M)
     eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
     eps.setType(SLEPc.EPS.Type.KRYLOVSCHUR)
-    eps.setDimensions(nev=nev, ncv=max(2 * nev, nev + 32))
+    # nev + 32 Krylov vectors: twice nev (SLEPc's default) costs more in orthogonalisation than it saves in
+    # restarts (the paper scene's 204 requested pairs: 0.40 s against 0.69 s)
+    eps.setDimensions(nev=nev, ncv=nev + 32)
     eps.setTarget(target)
     eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
     shift_and_invert(eps.getST(), PETSc.PC.Type.CHOLESKY)
