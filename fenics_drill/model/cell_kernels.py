@@ -42,10 +42,13 @@ def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, s
     """Add every cell's element tensor to ``out``: at the positions ``cell_dofs`` (a vector of ``size``, or
     with ``square`` a (size x size) matrix, row-major: the element matrix's rows are its test functions);
     or, with a ``basis`` of N > 0 columns (the rows of [Phi] at the dofs), projected on it: P_c^T f_c, or
-    P_c^T K_c P_c (N x N) with P_c the basis rows of cell c's dofs."""
+    P_c^T K_c P_c (N x N) with P_c the basis rows of cell c's dofs, summed over the cells as one product of
+    the stacked P_c and K_c P_c (BLAS: three quarters of the work, 52 cells of the printed kinematics)."""
     n, modes = cell_dofs.shape[1], basis.shape[1]
     element = np.empty(n * n if square else n)
-    work = np.empty((n, modes))
+    # a projected matrix: K_c P_c and P_c of every cell stacked, and P^T (K P) as one BLAS product at the end
+    stacked = cell_dofs.shape[0] * n if square and modes > 0 else 0
+    weighted, rows = np.empty((stacked, modes)), np.empty((stacked, modes))
     entity, permutation = np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
     for c in range(cell_dofs.shape[0]):
         element[:] = 0.0
@@ -60,22 +63,21 @@ def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, s
             for k in range(n):
                 out[cell_dofs[c, k]] += element[k]
         elif square:
-            for k in range(n):  # K_c P_c
-                for j in range(modes):
-                    value = 0.0
-                    for m in range(n):
-                        value += element[k * n + m] * basis[cell_dofs[c, m], j]
-                    work[k, j] = value
-            for i in range(modes):  # P_c^T (K_c P_c)
-                for k in range(n):
-                    weight = basis[cell_dofs[c, k], i]
+            for k in range(n):  # K_c P_c, and P_c, along the rows of [Phi]
+                row = c * n + k
+                weighted[row, :] = 0.0
+                for m in range(n):
+                    value, dof = element[k * n + m], cell_dofs[c, m]
                     for j in range(modes):
-                        out[i * modes + j] += weight * work[k, j]
+                        weighted[row, j] += value * basis[dof, j]
+                rows[row, :] = basis[cell_dofs[c, k], :]
         else:
             for k in range(n):
                 value, row = element[k], cell_dofs[c, k]
                 for j in range(modes):
                     out[j] += value * basis[row, j]
+    if stacked:  # sum over the cells of P_c^T (K_c P_c)
+        out += np.dot(rows.T, weighted).ravel()
 
 
 @njit(cache=True)
