@@ -77,7 +77,7 @@ def _with_element_sample(model: DrillstringModel, scene, equilibrium: StaticEqui
     was if that run fails (said in its ``hyper_reduction`` report)."""
     clock = time.perf_counter()
     horizon = min(scene.reduction.hyper_training, scene.time.t_end)
-    simulation = Simulation(model, scene)
+    simulation = Simulation(model, scene, energy_budget=False)  # only its states are kept
     states = []
     try:
         simulation.run(simulation.initial_state(equilibrium.q), horizon,
