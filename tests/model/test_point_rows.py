@@ -30,3 +30,8 @@ def test_point_rows_are_the_rows_of_phi(rule):
     assert np.allclose(rows.spread(f), expected.T @ f, rtol=1e-13, atol=1e-13)
     assert np.allclose(block, expected.T @ jacobian @ expected, rtol=1e-13, atol=1e-13 * np.abs(jacobian).max())
     assert np.array_equal(rows.subset([2]).dense(), expected[[2]])
+    # P^T e_k: the generalised force of a unit load on dof k is column k of P^T (row k of P), exactly (a
+    # copy of the row, or a scatter of one entry); zero for the held dof
+    for k, load in enumerate(rows.unit_loads()):
+        assert np.array_equal(load, expected[k])
+    assert not rows.unit_loads()[1].any()
