@@ -169,7 +169,8 @@ class ModalSpace:
         n, m = tangent.shape[0], constraints.shape[0]
         k = constraint_scale(tangent, constraints)
         system = np.empty((n + m, n + m), order="F")  # LAPACK's order: factorised in place, no copy
-        system[:n, :n], system[:n, n:], system[n:, :n], system[n:, n:] = tangent, k * constraints.T, k * constraints, 0.0
+        system[:n, :n], system[:n, n:] = tangent, k * constraints.T
+        system[n:, :n], system[n:, n:] = k * constraints, 0.0
         factors, pivots, info = getrf(system, overwrite_a=True)
         if info < 0:
             raise ValueError(f"getrf: argument {-info} is invalid")

@@ -47,9 +47,10 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
     ``check(iteration, q, mu, evaluation, norm, gap)`` returns the result to stop with,
     or None to go on (it may raise).  ``first_step(dq)`` limits the move of an update (default 1: none);
     a limited update is taken without the line search, as a trust region's step: far from the solution
-    (a straight string falling onto the wall) the residual need not decrease along it.  With ``reuse_rate`` > 0 the tangent of an earlier iterate is kept
-    while each full update shrinks the residual norm at least by that factor (a modified Newton with a
-    convergence-rate test; Deuflhard 2004, Sec. 2.1); a slower or damped update takes a fresh one.
+    (a straight string falling onto the wall) the residual need not decrease along it.  With
+    ``reuse_rate`` > 0 the tangent of an earlier iterate is kept while each full update shrinks the
+    residual norm at least by that factor (a modified Newton with a convergence-rate test; Deuflhard
+    2004, Sec. 2.1); a slower or damped update takes a fresh one.
     ``kink_step(evaluation, dq)`` gives the fraction of an update just past the first kink of a force
     law along it (None if there is none before the full update): the line search's second trial.
     Returns None when ``max_iterations`` updates did not satisfy ``check``.
