@@ -27,13 +27,17 @@ def backtrack(trial, norm0: float, step: float = 1.0, kink=None):
 
     ``kink()``: the step just past the first kink of a force law along the update (a branch the tangent
     did not see), or None; asked only when the first trial fails, it is tried next and the halving goes
-    on from it."""
+    on from it.  The kink's trial is taken if it does not raise the norm: its purpose is the new branch's
+    tangent, and from an iterate that sits on the kink itself it is a step of a few ulps, which cannot
+    decrease the norm by Armijo's share."""
+    at_kink = False
     for attempt in range(HALVINGS):
         norm, payload = trial(step)
-        if norm < (1.0 - ARMIJO * step) * norm0:
+        if norm < (1.0 - ARMIJO * step) * norm0 or (at_kink and norm <= norm0):
             break
         past = kink() if attempt == 0 and kink is not None else None
-        step = past if past is not None and past < step else 0.5 * step
+        at_kink = past is not None and past < step
+        step = past if at_kink else 0.5 * step
     return step, norm, payload
 
 

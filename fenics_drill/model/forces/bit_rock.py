@@ -83,15 +83,18 @@ def torque_regularisation_slope(omega):
     return _REGULARISATION_SLOPE(omega)
 
 
-#: A Newton update that crosses a kink is cut this much (relatively) past it, on the new branch.
+#: A Newton update that crosses a kink is cut this share of the update past it, on the new branch.
 KINK_PAST = 1e-6
 
 
 def step_past_kink(value: float, change: float) -> float | None:
-    """The step s in (0, 1) just past where value + s change crosses zero (None if it does not)."""
-    if value == 0.0 or change == 0.0 or value * change > 0.0 or abs(change) <= abs(value):
+    """The step s in (0, 1] that lands KINK_PAST of the change past where value + s change crosses zero
+    (None if it does not).  Past by a share of the change, not of the distance: an iterate sitting on the
+    kink (value ~ 1e-19 after round-off) must still land on the new branch, beyond the round-off of the
+    velocity it is computed from."""
+    if change == 0.0 or value * change > 0.0 or abs(change) <= abs(value):
         return None
-    return min(-value / change * (1.0 + KINK_PAST), 1.0)
+    return min(-value / change + KINK_PAST, 1.0)
 
 
 @dataclass
