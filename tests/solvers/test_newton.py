@@ -50,6 +50,7 @@ def test_the_line_search_tries_the_step_just_past_a_kink_and_then_converges_on_t
     # (the last lands at y = 1/32, on the stiff side), and only then does the stiff branch's tangent take it
     # to the root: three times the evaluations
     (plain_root, plain_updates), plain_evaluations = solve(with_kink=False)
+    # the same stopping test |r| <= 1e-12 b on the stiff branch (r' = 1 + K): within 1e-12 of y*, as above
     assert plain_root == pytest.approx(LOAD / (1 + STIFF), rel=1e-12)
     assert plain_evaluations == 9 and plain_updates == 4
 
