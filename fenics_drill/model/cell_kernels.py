@@ -157,7 +157,9 @@ class CellAssembly:
     """A form with one cell integral assembled from packed coefficients: a functional (a number), a linear
     form (a vector at the dofs ``dofs``) or a bilinear form of one space (a dense matrix at those dofs)."""
 
-    def __init__(self, form: fem.Form, dofs: np.ndarray | None = None):
+    def __init__(self, form: fem.Form, dofs: np.ndarray | None = None, cells: np.ndarray | None = None):
+        """``cells``: those of the form's cell integral to assemble (default: all), in the order of the
+        packed coefficients given."""
         cell = fem.IntegralType.cell
         if set(form.integral_types) != {cell} or form.num_integrals(cell, 0) != 1:
             raise ValueError("CellAssembly takes a form with exactly one cell integral")
@@ -165,7 +167,8 @@ class CellAssembly:
             raise ValueError("CellAssembly takes a bilinear form of one space")
         integral = form.ufcx_form.form_integrals[0]
         self.address = int(_FFI.cast("uintptr_t", integral.tabulate_tensor_float64))
-        cells = form._cpp_object.domains(cell, 0)  # in the order of the packed coefficients
+        if cells is None:
+            cells = form._cpp_object.domains(cell, 0)  # in the order of the packed coefficients
         self.coordinates = _cell_coordinates(form.mesh, cells)
         self.rank = form.rank
         if self.rank == 0:

@@ -24,7 +24,6 @@ import numpy as np
 import scipy.sparse as sp
 import ufl
 from dolfinx import fem
-from dolfinx.mesh import meshtags
 from petsc4py import PETSc
 
 from fenics_drill.forms import energies
@@ -72,14 +71,15 @@ class ElementSample:
 
 class InternalForms:
     """The UFL forms of the internal force of one string: the residual of (43), its derivatives by the
-    displacement, velocity and acceleration fields, and the kinetic and strain energies, on all elements
-    or on an element sample (weighted, the nonlinear remainder only).
+    displacement, velocity and acceleration fields, and the kinetic and strain energies; whole, or
+    ``sampled``: the nonlinear remainder only, weighted cell by cell by the DG0 function ``weight``.
 
-    Compiling them costs about 0.5 s, and the whole string's forms do not depend on the solution space:
+    Building them costs about 0.3 s, and they depend neither on the solution space nor on the sample:
     :meth:`of` builds them once per string and switches, and the models of a string (reduced, enriched,
-    full order) share them and their functions U, V, A."""
+    full order; each element sample and the trainer of a sample) share them and their functions U, V, A.
+    A sample is a choice of cells and their weights (:class:`SampledCoefficients`), not a form."""
 
-    def __init__(self, disc: BeamDiscretization, switches: tuple, sample: ElementSample | None):
+    def __init__(self, disc: BeamDiscretization, switches: tuple, sampled: bool):
         geometric_nonlinearity, inertial_nonlinearity, kinematics, angular_velocity = switches
         p = disc.properties
         # Energies are polynomials of degree <= 4 in the fields up to sin/cos(theta_x):
@@ -87,28 +87,20 @@ class InternalForms:
         metadata = {"quadrature_degree": 2 * disc.element_degree}
         self.functions = U, V, A = tuple(fem.Function(disc.V) for _ in range(3))
         psi, dU = ufl.TestFunction(disc.V), ufl.TrialFunction(disc.V)
-        if sample is None:
-            dx, weight, self.dofs = ufl.Measure("dx", domain=disc.mesh, metadata=metadata), 1.0, None
-        else:
-            cells = np.asarray(sample.cells, dtype=np.int32)
-            tags = meshtags(disc.mesh, disc.mesh.topology.dim, cells, np.ones_like(cells))
-            dx = ufl.Measure("dx", domain=disc.mesh, subdomain_data=tags, metadata=metadata)(1)
-            weight = fem.Function(fem.functionspace(disc.mesh, ("DG", 0)))
-            weight.x.array[cells] = sample.weights
-            self.weight = weight
-            self.dofs = np.unique(disc.V.dofmap.list[cells]).astype(PETSc.IntType)
+        dx = ufl.Measure("dx", domain=disc.mesh, metadata=metadata)
+        weight = self.weight = fem.Function(fem.functionspace(disc.mesh, ("DG", 0))) if sampled else 1.0
 
         def forces(geometric, inertial):
             return (energies.inertial_force(p, psi, U, V, A, dx, inertial, angular_velocity, weight)
                     + energies.elastic_force(p, psi, U, dx, geometric, kinematics, weight))
 
         def energy(density, linear_density):
-            return weight * (density - linear_density if sample is not None else density) * dx
+            return weight * (density - linear_density if sampled else density) * dx
 
         residual = forces(geometric_nonlinearity, inertial_nonlinearity)
         kinetic = energies.kinetic_energy_density(p, U, V, inertial_nonlinearity, angular_velocity)
         strain = energies.strain_energy_density(p, energies.strain_slots(U), geometric_nonlinearity, kinematics)
-        if sample is None:
+        if not sampled:
             residual = residual + energies.damping_force(p, psi, V, dx)
         else:  # the nonlinear remainder; the linear part is applied with projected matrices
             residual = residual - forces(False, False)
@@ -120,18 +112,16 @@ class InternalForms:
         self.jacobians = tuple(_nonzero_form(ufl.derivative(residual, field, dU)) for field in (U, V, A))
 
     @classmethod
-    def of(cls, disc: BeamDiscretization, switches: tuple, sample: ElementSample | None) -> "InternalForms":
-        """The forms of a string: shared for the whole string, built afresh for an element sample."""
-        if sample is not None:
-            return cls(disc, switches, sample)
-        built = _WHOLE_STRING.setdefault(disc, {})
-        if switches not in built:
-            built[switches] = cls(disc, switches, None)
-        return built[switches]
+    def of(cls, disc: BeamDiscretization, switches: tuple, sampled: bool) -> "InternalForms":
+        """The forms of a string, whole or ``sampled``: built on first use, then shared."""
+        built = _FORMS.setdefault(disc, {})
+        if (switches, sampled) not in built:
+            built[switches, sampled] = cls(disc, switches, sampled)
+        return built[switches, sampled]
 
 
-#: The whole-string forms of each string (discretization) alive, by their switches.
-_WHOLE_STRING: "weakref.WeakKeyDictionary[BeamDiscretization, dict]" = weakref.WeakKeyDictionary()
+#: The forms of each string (discretization) alive, by their switches and whether they are sampled.
+_FORMS: "weakref.WeakKeyDictionary[BeamDiscretization, dict]" = weakref.WeakKeyDictionary()
 
 
 class AssembledInternalForce:
@@ -148,11 +138,12 @@ class AssembledInternalForce:
                  angular_velocity: str = "consistent", sample: ElementSample | None = None):
         self.space, self.sample = space, sample
         self.switches = (geometric_nonlinearity, inertial_nonlinearity, kinematics, angular_velocity)
-        forms = InternalForms.of(disc, self.switches, sample)
+        forms = InternalForms.of(disc, self.switches, sample is not None)
         self.U, self.V, self.A = forms.functions
         self._kinetic, self._strain, self._residual, self._jacobians = (forms.kinetic, forms.strain, forms.residual,
                                                                        forms.jacobians)
-        self.dofs = forms.dofs
+        # the dofs of the sampled cells: the only ones their kernels read
+        self.dofs = None if sample is None else np.unique(disc.V.dofmap.list[sample.cells]).astype(PETSc.IntType)
         self._vector = fem_petsc.create_vector(self._residual.function_spaces)
         if sample is None:  # DOLFINx's own CSR matrices, read at the entries that matter
             self._matrices = tuple(TangentEntries(form, space, forms.functions) if form is not None
@@ -168,7 +159,9 @@ class AssembledInternalForce:
         self._state = None
 
     def _sampled(self, form: fem.Form, functions) -> "SampledCoefficients":
-        return SampledCoefficients(form, functions, self.dofs, self.phi_rows)
+        self.weight.x.array[:] = 0.0  # the forms' weight is shared: this sample's is set where it is packed
+        self.weight.x.array[self.sample.cells] = self.sample.weights
+        return SampledCoefficients(form, functions, self.dofs, self.phi_rows, self.sample.cells)
 
     # the sampled forms' coefficient maps, built on first use (a trainer of the sample assembles through
     # DOLFINx and never needs them)
@@ -197,7 +190,7 @@ class AssembledInternalForce:
 
     def assembled_vector(self, q, qd, qdd) -> np.ndarray:
         """The assembled (full-space) vector of the residual form at a state: the whole force, or the
-        sample's weighted nonlinear remainder."""
+        nonlinear remainder weighted by the forms' ``weight`` on every cell (what a trainer of a sample sets)."""
         self._set(self.U, q)
         self._set(self.V, qd)
         self._set(self.A, qdd)
@@ -259,16 +252,20 @@ class SampledCoefficients:
     (:class:`~fenics_drill.model.cell_kernels.CellAssembly`), without setting the functions or DOLFINx's
     packing and assembly paths."""
 
-    def __init__(self, form: fem.Form, functions, dofs: np.ndarray, phi_rows: np.ndarray):
+    def __init__(self, form: fem.Form, functions, dofs: np.ndarray, phi_rows: np.ndarray, cells: np.ndarray):
+        """``cells``: the sample (the form is integrated over all cells: its packing is read at these)."""
         for function in functions:
             function.x.array[:] = 0.0
         (key, packed), = fem.pack_coefficients(form).items()
-        self.offset = packed.ravel().copy()
+        position = np.full(form.mesh.topology.index_map(form.mesh.topology.dim).size_local, -1)
+        position[form._cpp_object.domains(fem.IntegralType.cell, 0)] = np.arange(len(packed))
+        at = position[cells]
+        self.offset = packed[at].ravel().copy()
         columns = []
         for function in functions:
             for column in phi_rows.T:
                 function.x.array[dofs] = column
-                columns.append(fem.pack_coefficients(form)[key].ravel() - self.offset)
+                columns.append(fem.pack_coefficients(form)[key][at].ravel() - self.offset)
             function.x.array[:] = 0.0
         # each packed entry is a dof of one function (or of none, as the weight): kept as the row of the map
         # over that function's reduced values alone, a third of the map over the whole stacked state
@@ -279,7 +276,7 @@ class SampledCoefficients:
         self.rows, self.row_function = np.nonzero(depends)
         self.rows_map = np.ascontiguousarray(by_function[self.rows, self.row_function])
         self.basis = np.ascontiguousarray(phi_rows)
-        self.cells = CellAssembly(form, dofs)
+        self.cells = CellAssembly(form, dofs, cells)
 
     def assemble(self, state: np.ndarray):
         """The assembled number, or the vector or matrix projected on [Phi] (cell by cell), at the reduced

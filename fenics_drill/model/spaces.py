@@ -130,6 +130,10 @@ class ModalSpace:
     def expand(self, q: np.ndarray) -> np.ndarray:
         return self.phi @ q
 
+    def expand_rows(self, states: np.ndarray) -> np.ndarray:
+        """The full-space dofs of many states (one per row): one product with [Phi] for all of them."""
+        return states @ self.phi.T
+
     def project(self, vector: np.ndarray) -> np.ndarray:
         return self.phi.T @ vector
 
@@ -222,6 +226,12 @@ class FullSpace:
     def expand(self, q: np.ndarray) -> np.ndarray:
         out = np.zeros(self.ndofs)
         out[self.free] = q
+        return out
+
+    def expand_rows(self, states: np.ndarray) -> np.ndarray:
+        """The full-space dofs of many states (one per row)."""
+        out = np.zeros((len(states), self.ndofs))
+        out[:, self.free] = states
         return out
 
     def project(self, vector: np.ndarray) -> np.ndarray:

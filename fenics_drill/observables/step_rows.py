@@ -47,8 +47,16 @@ VARIABLES = {**STATE_VARIABLES, **recorded_variables()}
 
 
 class StepRows:
-    """Turns a :class:`StepRecord` into a dict of scalars (the bit, the section, the stress, energies,
-    and what each point force records; zeros for the forces the scene leaves off)."""
+    """Turns accepted steps (:class:`StepRecord`) into dicts of scalars: the bit, the section, the stress,
+    energies, and what each point force records (zeros for the forces the scene leaves off).
+
+    What a step's record alone knows (its time, multipliers, energies, the forces' records) is read when
+    the step is taken; what follows from its state (the bit and section values, the von Mises maximum
+    over the string) is computed for BATCH steps together, with one product of [Phi] with all their
+    states instead of one per step (benchmarks/RESULTS.md, item 35)."""
+
+    #: Steps whose state observables are computed together.
+    BATCH = 64
 
     def __init__(self, model: DrillstringModel, scene):
         self.model = model
@@ -64,13 +72,38 @@ class StepRows:
         self.stress = VonMisesProbe(disc, flags.geometric_nonlinearity, flags.kinematics) \
             if scene.output.von_mises else None
         self.absent = {name: 0.0 for name in recorded_variables()}
+        self._pending: list[tuple[dict, object]] = []  # (what the record gave, state) of steps not yet returned
 
-    def __call__(self, record: StepRecord, dofs: np.ndarray) -> dict:
-        """The row of one step; ``dofs`` is the full-space displacement Phi q of the step."""
+    def add(self, record: StepRecord) -> list[dict]:
+        """Take an accepted step; returns the rows it completes: BATCH rows every BATCH steps, else none."""
+        self._pending.append((self._record_scalars(record), record.state))
+        return self.complete() if len(self._pending) >= self.BATCH else []
+
+    def complete(self) -> list[dict]:
+        """The rows of the steps taken and not yet returned, in their order."""
+        if not self._pending:
+            return []
+        scalars, states = zip(*self._pending)
+        q = np.array([s.q for s in states])
+        values = np.asarray(self.point_rows @ q.T).T.tolist()  # (steps, 5)
+        rates = np.asarray(self.point_rows @ np.array([s.qd for s in states]).T).T.tolist()
+        if self.stress is not None:
+            stresses = [self.stress.maximum(dofs) for dofs in self.model.space.expand_rows(q)]
+        else:
+            stresses = [(np.nan, np.nan)] * len(states)
+        rows = []
+        for known, (u, tx, v, w, _), (du, dtx, dv, dw, dsx), (stress, stress_x) in zip(scalars, values, rates,
+                                                                                    stresses):
+            rows.append({**known, "bit_displacement": u, "bit_velocity": du, "bit_rotation": tx,
+                         "bit_angular_velocity": dtx, "section_v": v, "section_w": w, "section_v_velocity": dv,
+                         "section_w_velocity": dw, "section_theta_x_velocity": dsx, "max_von_mises": stress,
+                         "max_von_mises_x": stress_x})
+        self._pending.clear()  # only now: a row interrupted while computed is still pending
+        return rows
+
+    def _record_scalars(self, record: StepRecord) -> dict:
+        """The row's values that the step's record gives (all but those of its state's observables)."""
         s = record.state
-        u, tx, v, w, _ = (self.point_rows @ s.q).tolist()
-        du, dtx, dv, dw, dsx = (self.point_rows @ s.qd).tolist()
-        stress, stress_x = self.stress.maximum(dofs) if self.stress is not None else (np.nan, np.nan)
         budget = record.budget
         kinetic, strain, work, dissipated = (np.nan,) * 4 if budget is None else (
             budget.kinetic, budget.strain, budget.input_work, budget.total_dissipated)
@@ -78,11 +111,8 @@ class StepRows:
         top_velocity, top_spin = self.model.drive.velocities(s.qd)
         row = {
             "time": s.t, "dt": record.dt, "newton_iterations": record.newton_iterations,
-            "bit_displacement": u, "bit_velocity": du, "bit_rotation": tx, "bit_angular_velocity": dtx,
             "lambda_1": -force, "lambda_4": -torque, "top_velocity": top_velocity,
             "top_angular_velocity": top_spin, "impacts": int(record.onsets.sum()),
-            "section_v": v, "section_w": w, "section_v_velocity": dv, "section_w_velocity": dw,
-            "section_theta_x_velocity": dsx, "max_von_mises": stress, "max_von_mises_x": stress_x,
             "kinetic_energy": kinetic, "strain_energy": strain, "input_work": work, "dissipated_energy": dissipated,
             **self.absent,
         }

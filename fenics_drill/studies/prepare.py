@@ -121,19 +121,29 @@ class RealisationRecorder:
     def __init__(self, model: DrillstringModel, scene):
         self.model = model
         self.rows = StepRows(model, scene)
-        self.series: dict[str, list] = defaultdict(list)
+        self._series: dict[str, list] = defaultdict(list)
         self.q_norm_integral = 0.0
         self._last: tuple[float, float] | None = None
 
     def __call__(self, record) -> None:
         s = record.state
-        for key, value in self.rows(record, self.model.space.expand(s.q)).items():
-            self.series[key].append(value)
+        self._keep(self.rows.add(record))
         q2 = float(s.q @ s.q)
         if self._last is not None:
             t0, q20 = self._last
             self.q_norm_integral += 0.5 * (q20 + q2) * (s.t - t0)
         self._last = (s.t, q2)
+
+    def _keep(self, rows: list[dict]) -> None:
+        for row in rows:
+            for key, value in row.items():
+                self._series[key].append(value)
+
+    @property
+    def series(self) -> dict[str, list]:
+        """Every variable's values at the steps taken so far."""
+        self._keep(self.rows.complete())
+        return self._series
 
 
 def run_realisation(prepared: PreparedScene, scene) -> dict:

@@ -80,7 +80,8 @@ class RunRecorder:
     """Turns accepted steps (and the initial state) into time-series rows and XDMF snapshots."""
 
     def __init__(self, model: DrillstringModel, scene, out: Path, on_write=None):
-        """``on_write(state)`` is called after each write of the files (the running summary)."""
+        """``on_write(t)`` is called after each write of the files, with the time of the last row written
+        (the running summary)."""
         self.model = model
         self.on_write = on_write
         self.rows = StepRows(model, scene)
@@ -95,26 +96,38 @@ class RunRecorder:
         self.fields = FieldWriter(model.disc, out / "fields.xdmf", with_stress=self.rows.stress is not None) \
             if self.field_interval > 0 else None
         self.next_field_time = 0.0
-        self.last_state = None  # the latest state whose row is in the series (what an interrupted run reports)
+        # the latest state taken (what an interrupted run reports): its row is in the series at the latest when
+        # the recorder closes
+        self.last_state = None
 
-    def _write_fields(self, t: float, dofs: np.ndarray) -> None:
-        if self.fields is not None and t >= self.next_field_time - 1e-12:
+    def _write_fields(self, state) -> None:
+        if self.fields is not None and state.t >= self.next_field_time - 1e-12:
+            dofs = self.model.space.expand(state.q)
             stress = self.rows.stress.cell_stress(dofs) if self.rows.stress is not None else None
-            self.fields.write(dofs, t, stress)
-            self.next_field_time = self.field_interval * (np.floor(t / self.field_interval + 1e-9) + 1)
+            self.fields.write(dofs, state.t, stress)
+            self.next_field_time = self.field_interval * (np.floor(state.t / self.field_interval + 1e-9) + 1)
 
     def __call__(self, record: StepRecord) -> None:
-        dofs = self.model.space.expand(record.state.q)
-        self._write_fields(record.state.t, dofs)
-        written = self.series.append(self.rows(record, dofs))
+        self._write_fields(record.state)
+        completed = self.rows.add(record)
         self.last_state = record.state
-        if written:
+        self._append(completed)
+
+    def _append(self, rows: list[dict]) -> None:
+        written = None  # the time of the last row written to the file
+        for row in rows:
+            if self.series.append(row):
+                written = row["time"]
+        if written is not None:
             if self.fields is not None:
                 self.fields.flush()
             if self.on_write is not None:
-                self.on_write(record.state)
+                self.on_write(written)
 
     def close(self, impacts_per_vertex: np.ndarray) -> None:
+        """The rows still pending (:class:`StepRows` completes them in batches) and the impact counts
+        written; the files closed."""
+        self._append(self.rows.complete())
         self.series.close(impacts_per_vertex)
         if self.fields is not None:
             self.fields.close()
@@ -135,8 +148,8 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
     summary: dict = {"command": "run", "status": "failed", "message": "", "t_end": 0.0, "steps": 0}
     recorder = simulation = None
 
-    def running(state) -> None:
-        write_json(out / "summary.json", {**summary, "status": "running", "pid": os.getpid(), "t_end": state.t,
+    def running(t: float) -> None:
+        write_json(out / "summary.json", {**summary, "status": "running", "pid": os.getpid(), "t_end": t,
                                           "steps": simulation.stats["steps"],
                                           "wall_time_s": time.perf_counter() - clock})
 

@@ -17,15 +17,31 @@ from fenics_drill.studies.prepare import prepare
 STRING = ("beam.length=20.0", "beam.elements=40", "output.field_interval=0")
 
 
+class Sampled:
+    """A string's sampled forms with the weights of one element sample set (zero on the other cells), its
+    cells and their dofs, and DOLFINx's packed coefficients of a form read at those cells."""
+
+    def __init__(self, disc, forms, sample):
+        self.disc, self.forms, self.cells = disc, forms, sample.cells
+        forms.weight.x.array[:] = 0.0
+        forms.weight.x.array[sample.cells] = sample.weights
+        self.dofs = np.unique(disc.V.dofmap.list[sample.cells])
+
+    def packed(self, form):
+        (key, packed), = fem.pack_coefficients(form).items()
+        return packed[self.cells]  # a form on all cells packs them in the mesh's order
+
+
 @pytest.fixture(scope="module")
 def sampled_forms():
     scene = scene_with(*STRING)
     disc = BeamDiscretization.from_scene(scene)
     m = scene.model
-    # unsorted cells with unequal weights: the assembly must follow the form's own order of the cells
+    # unsorted cells with unequal weights: the assembly must follow the given order of the cells
     sample = ElementSample(np.array([31, 2, 17, 9]), np.array([0.7, 1.9, 1.1, 2.5]))
-    return disc, InternalForms(disc, (m.geometric_nonlinearity, m.inertial_nonlinearity, m.kinematics,
-                                      m.angular_velocity), sample)
+    forms = InternalForms(disc, (m.geometric_nonlinearity, m.inertial_nonlinearity, m.kinematics,
+                                 m.angular_velocity), sampled=True)
+    return Sampled(disc, forms, sample)
 
 
 def test_the_cells_kernels_give_dolfinx_assembly_of_the_sampled_force(sampled_forms):
@@ -33,28 +49,26 @@ def test_the_cells_kernels_give_dolfinx_assembly_of_the_sampled_force(sampled_fo
     polynomial and sine of the energies is active), the vector of the sampled cells' kernels equals DOLFINx's
     assemble_vector at the sampled dofs.  Both add the same element vectors of the same kernel, only in
     another order: they agree to round-off (1e-13 of the largest entry)."""
-    disc, forms = sampled_forms
+    forms, dofs = sampled_forms.forms, sampled_forms.dofs
     rng = np.random.default_rng(7)
-    assembly = CellAssembly(forms.residual, forms.dofs)
-    (key, _), = fem.pack_coefficients(forms.residual).items()
+    assembly = CellAssembly(forms.residual, dofs, sampled_forms.cells)
     for _ in range(3):
         for function in forms.functions:
             function.x.array[:] = 0.3 * rng.standard_normal(function.x.array.size)
-        packed = fem.pack_coefficients(forms.residual)[key]
         reference = fem.assemble_vector(forms.residual).array
-        ours = assembly(packed)
+        ours = assembly(sampled_forms.packed(forms.residual))
         assert np.abs(reference).max() > 0
         # the same element vectors added in another order: round-off of the largest entry's size
-        np.testing.assert_allclose(ours, reference[forms.dofs], rtol=0, atol=1e-13 * np.abs(reference).max())
-        # the sampled cells touch no other dof
-        assert np.abs(np.delete(reference, forms.dofs)).max() == 0.0
+        np.testing.assert_allclose(ours, reference[dofs], rtol=0, atol=1e-13 * np.abs(reference).max())
+        # the cells of zero weight add nothing: the sampled cells touch no other dof
+        assert np.abs(np.delete(reference, dofs)).max() == 0.0
 
 
 def test_the_cells_kernels_give_dolfinx_assembly_of_the_sampled_tangents_and_energies(sampled_forms):
     """The same for the sampled tangents df/dq, df/dqd, df/dqdd (dense at the sampled dofs, against DOLFINx's
     assemble_matrix) and the kinetic and strain energies (against assemble_scalar): the same element tensors
     added in another order, so round-off of the largest entry (1e-13)."""
-    disc, forms = sampled_forms
+    forms, dofs, cells = sampled_forms.forms, sampled_forms.dofs, sampled_forms.cells
     rng = np.random.default_rng(8)
     for _ in range(2):
         for function in forms.functions:
@@ -62,23 +76,22 @@ def test_the_cells_kernels_give_dolfinx_assembly_of_the_sampled_tangents_and_ene
         for jacobian in forms.jacobians:
             if jacobian is None:
                 continue
-            (key, packed), = fem.pack_coefficients(jacobian).items()
             reference = fem.assemble_matrix(jacobian).to_dense()
-            ours = CellAssembly(jacobian, forms.dofs)(packed)
+            ours = CellAssembly(jacobian, dofs, cells)(sampled_forms.packed(jacobian))
             assert np.abs(reference).max() > 0
             # the same element matrices added in another order: an entry sums at most two cells' values,
             # so a few ulps of the largest entry; 1e-13 is about 500 eps
-            np.testing.assert_allclose(ours, reference[np.ix_(forms.dofs, forms.dofs)], rtol=0,
+            np.testing.assert_allclose(ours, reference[np.ix_(dofs, dofs)], rtol=0,
                                        atol=1e-13 * np.abs(reference).max())
             untouched = np.ones(reference.shape, dtype=bool)
-            untouched[np.ix_(forms.dofs, forms.dofs)] = False
+            untouched[np.ix_(dofs, dofs)] = False
             assert np.abs(reference[untouched]).max() == 0.0
         for energy in (forms.kinetic, forms.strain):
-            (key, packed), = fem.pack_coefficients(energy).items()
             reference = fem.assemble_scalar(energy)
             assert reference != 0.0
             # the same four cell integrals summed in another order: a few ulps of the sum
-            assert CellAssembly(energy)(packed) == pytest.approx(reference, rel=1e-13, abs=0.0)
+            assert CellAssembly(energy, cells=cells)(sampled_forms.packed(energy)) == pytest.approx(
+                reference, rel=1e-13, abs=0.0)
 
 
 def test_the_sampled_forms_projected_cell_by_cell_are_the_projections_of_their_assembly(sampled_forms):
@@ -87,18 +100,17 @@ def test_the_sampled_forms_projected_cell_by_cell_are_the_projections_of_their_a
     and Phi_s^T A Phi_s of the matrix assembled at the sampled dofs from the same state.  Sums of the same
     products in another order: round-off of the largest entry (1e-12, the projections adding 59-term sums
     to the element tensors' 1e-13)."""
-    disc, forms = sampled_forms
+    forms, dofs, cells = sampled_forms.forms, sampled_forms.dofs, sampled_forms.cells
     rng = np.random.default_rng(9)
-    basis = np.ascontiguousarray(rng.standard_normal((len(forms.dofs), 7)))
-    sampled = [SampledCoefficients(form, forms.functions, forms.dofs, basis)
+    basis = np.ascontiguousarray(rng.standard_normal((len(dofs), 7)))
+    sampled = [SampledCoefficients(form, forms.functions, dofs, basis, cells)
                for form in (forms.residual, *forms.jacobians) if form is not None]
     state = 0.3 * rng.standard_normal(3 * basis.shape[1])
     for function, values in zip(forms.functions, state.reshape(3, -1)):
         function.x.array[:] = 0.0
-        function.x.array[forms.dofs] = basis @ values
+        function.x.array[dofs] = basis @ values
     for form, coefficients in zip((forms.residual, *(j for j in forms.jacobians if j is not None)), sampled):
-        (key, packed), = fem.pack_coefficients(form).items()
-        at_dofs = CellAssembly(form, forms.dofs)(packed)
+        at_dofs = CellAssembly(form, dofs, cells)(sampled_forms.packed(form))
         reference = basis.T @ at_dofs if at_dofs.ndim == 1 else basis.T @ at_dofs @ basis
         ours = coefficients.assemble(state)
         assert np.abs(reference).max() > 0
@@ -108,11 +120,11 @@ def test_the_sampled_forms_projected_cell_by_cell_are_the_projections_of_their_a
 
 
 def test_cell_assembly_refuses_a_bilinear_form_of_two_spaces(sampled_forms):
-    disc, forms = sampled_forms
+    disc = sampled_forms.disc
     weights = fem.functionspace(disc.mesh, ("DG", 0))
     mixed = fem.form(ufl.TrialFunction(weights) * ufl.TestFunction(disc.V)[0] * ufl.dx(domain=disc.mesh))
     with pytest.raises(ValueError, match="one space"):
-        CellAssembly(mixed, forms.dofs)
+        CellAssembly(mixed, sampled_forms.dofs)
 
 
 def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
