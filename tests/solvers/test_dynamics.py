@@ -310,3 +310,31 @@ def test_an_unloaded_string_that_only_spins_keeps_its_rigid_spin():
     assert spin[2] == pytest.approx(2 * math.pi * last.t, rel=1e-9)
     assert spin[3] == pytest.approx(2 * math.pi, rel=1e-9)
     assert abs(sim.budget.summary()["input_work"]) < 1e-9  # J: no torque is needed to keep a free rigid spin
+
+
+@pytest.mark.parametrize("space", ["modal", "full"])
+def test_the_error_estimates_bound_changes_no_decision_of_the_step_control(space):
+    """Where the cheap bound sum_j max_i |R_ij| |e_j| of the step's error estimate already makes the
+    controller accept and propose the nominal step, it stands in for the estimate max_i |(R e)_i|: on
+    random accelerations of every size and steps from a quarter of the nominal to the nominal, every
+    verdict and every proposed step must be those of the estimate itself (and the bound never below it)."""
+    from fenics_drill.solvers.step_control import StepController
+
+    scene = scene_with("beam.length=20.0", "beam.elements=16")
+    model = build_model(scene)
+    model = model if space == "modal" else model.full_order()
+    rng = np.random.default_rng(3)
+    with_bound, exact = StepController(scene, 0.3, model.error_rows), StepController(scene, 0.3, model.error_rows)
+    used = 0
+    for _ in range(400):
+        dt = with_bound.nominal * rng.uniform(0.25, 1.0)
+        qdd = 10.0 ** rng.uniform(-1, 4) * rng.standard_normal((2, model.size))
+        ratio = with_bound.error_ratio(dt, *qdd)
+        e = exact.error_factor * dt * dt * (qdd[1] - qdd[0])
+        estimate = float(np.max(np.abs(exact.error_rows @ e))) / exact.tolerance
+        # the bound is a sum of the same products' magnitudes: never below the estimate beyond its round-off
+        assert ratio >= estimate * (1 - 1e-12)
+        used += ratio != estimate
+        assert with_bound.judge(dt, ratio) == exact.judge(dt, estimate)
+        assert with_bound.dt == exact.dt
+    assert used > 20  # the bound did stand in (else this test would test nothing)
