@@ -96,21 +96,21 @@ def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, si
 
 
 @kernel(fastmath=REASSOCIATE)
-def _assemble_cells_at(address, offset, rows, row_function, rows_map, state, constants, coordinates, cell_dofs, size,
-                       square, basis):
-    """:func:`_assemble_cells` with the packed coefficients ``offset`` + the map of the reduced state: entry
-    ``rows[i]`` of the packed array is row i of ``rows_map`` times the reduced values of function
-    ``row_function[i]`` (the slice of ``state`` that stacks them)."""
+def _assemble_cells_at(address, offset, rows, row_function, row_dof, state, constants, coordinates, cell_dofs, size,
+                       square, basis, projected):
+    """:func:`_assemble_cells` with the packed coefficients ``offset`` plus the functions' values at the dofs:
+    entry ``rows[i]`` of the packed array is the value of function ``row_function[i]`` (its reduced values are
+    that slice of ``state``) at dof ``row_dof[i]``, row ``row_dof[i]`` of ``basis`` times them; the result
+    projected on ``basis`` if ``projected`` (a vector or matrix), else summed as it is (a number)."""
+    functions, n = state.size // basis.shape[1], basis.shape[1]
+    values = np.dot(basis, np.ascontiguousarray(state.reshape(functions, n).T))  # (dofs, functions)
     packed = offset.copy()
-    n = rows_map.shape[1]
     for i in range(rows.size):
-        start, value = row_function[i] * n, 0.0
-        for j in range(n):
-            value += rows_map[i, j] * state[start + j]
-        packed[rows[i]] += value
-    out = _zeros_for(size, square, basis)
+        packed[rows[i]] += values[row_dof[i], row_function[i]]
+    projection = basis if projected else np.empty((basis.shape[0], 0))
+    out = _zeros_for(size, square, projection)
     _add_cells(address, packed.reshape(coordinates.shape[0], -1), constants, coordinates, cell_dofs, size, square,
-               basis, out)
+               projection, out)
     return out
 
 
@@ -201,12 +201,11 @@ class CellAssembly:
                                             self.constants, self.coordinates, self.cell_dofs, self.size,
                                             self.rank == 2, np.empty((self.size, 0))))
 
-    def projected(self, offset, rows, row_function, rows_map, state, basis):
+    def projected(self, offset, rows, row_function, row_dof, state, basis):
         """The number, or the vector or matrix projected on ``basis`` (the rows of [Phi] at the dofs:
-        P^T f, P^T K P), from the packed coefficients ``offset`` plus, at ``rows``, ``rows_map`` times the
-        slice ``row_function`` of ``state`` (the affine map of
-        :class:`~fenics_drill.model.internal_force.SampledCoefficients`)."""
-        basis = basis if self.rank > 0 else np.empty((1, 0))  # a functional is a number: nothing to project
-        return self._shaped(_assemble_cells_at(self.address, offset, rows, row_function, rows_map, state,
+        P^T f, P^T K P), from the packed coefficients ``offset`` plus, at ``rows``, the values at the dofs
+        ``row_dof`` of the functions ``row_function`` whose reduced values ``state`` stacks (the placement
+        of :class:`~fenics_drill.model.internal_force.SampledCoefficients`)."""
+        return self._shaped(_assemble_cells_at(self.address, offset, rows, row_function, row_dof, state,
                                                self.constants, self.coordinates, self.cell_dofs, self.size,
-                                               self.rank == 2, basis))
+                                               self.rank == 2, basis, self.rank > 0))

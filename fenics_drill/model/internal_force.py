@@ -247,10 +247,12 @@ class SampledCoefficients:
     directly from the reduced values of its ``functions`` (q, qd, qdd of U, V, A, stacked).
 
     The packed coefficients of the cells (what ``dolfinx.fem.pack_coefficients`` gives: the weight and
-    the dofs of the functions on each cell) are an affine function of the reduced state, found once by
-    packing the columns of [Phi]; an evaluation is then one small product and the cells' kernels
-    (:class:`~fenics_drill.model.cell_kernels.CellAssembly`), without setting the functions or DOLFINx's
-    packing and assembly paths."""
+    the dofs of the functions on each cell) are the weight and the functions' values at the sampled dofs.
+    An evaluation forms those values, the sampled rows of [Phi] times the reduced values of each function
+    (one product that reads the rows once; a map per packed entry would read each shared dof's row again
+    for every cell and function), places them where DOLFINx packs them (found once), and runs the cells'
+    kernels (:class:`~fenics_drill.model.cell_kernels.CellAssembly`), without setting the functions or
+    DOLFINx's packing and assembly paths."""
 
     def __init__(self, form: fem.Form, functions, dofs: np.ndarray, phi_rows: np.ndarray, cells: np.ndarray):
         """``cells``: the sample (the form is integrated over all cells: its packing is read at these)."""
@@ -260,28 +262,49 @@ class SampledCoefficients:
         position = np.full(form.mesh.topology.index_map(form.mesh.topology.dim).size_local, -1)
         position[form._cpp_object.domains(fem.IntegralType.cell, 0)] = np.arange(len(packed))
         at = position[cells]
-        self.offset = packed[at].ravel().copy()
-        columns = []
-        for function in functions:
-            for column in phi_rows.T:
-                function.x.array[dofs] = column
-                columns.append(fem.pack_coefficients(form)[key][at].ravel() - self.offset)
+
+        def pack() -> np.ndarray:
+            return fem.pack_coefficients(form)[key][at].ravel()
+
+        self.offset = pack().copy()
+        rows, row_function, row_dof = [], [], []
+        for f, function in enumerate(functions):  # each sampled dof numbered 1, 2, ...: where is it packed?
+            function.x.array[dofs] = np.arange(1, len(dofs) + 1)
+            numbered = pack() - self.offset
             function.x.array[:] = 0.0
-        # each packed entry is a dof of one function (or of none, as the weight): kept as the row of the map
-        # over that function's reduced values alone, a third of the map over the whole stacked state
-        by_function = np.column_stack(columns).reshape(len(self.offset), len(functions), len(phi_rows.T))
-        depends = np.abs(by_function).max(axis=2) != 0.0
-        if (depends.sum(axis=1) > 1).any():
+            entries = np.flatnonzero(numbered)
+            rows.append(entries)
+            row_function.append(np.full(entries.size, f))
+            row_dof.append(np.rint(numbered[entries]).astype(np.int64) - 1)
+        self.rows, self.row_function, self.row_dof = (np.concatenate(a) for a in (rows, row_function, row_dof))
+        if np.unique(self.rows).size != self.rows.size:
             raise ValueError("a packed coefficient depends on more than one function")
-        self.rows, self.row_function = np.nonzero(depends)
-        self.rows_map = np.ascontiguousarray(by_function[self.rows, self.row_function])
         self.basis = np.ascontiguousarray(phi_rows)
         self.cells = CellAssembly(form, dofs, cells)
+        # a packed entry that is not one dof's value as it is (a scaled or combined dof) would be misplaced:
+        # the placement must give DOLFINx's own packing at a random state
+        rng = np.random.default_rng(0)
+        state = rng.standard_normal(len(functions) * phi_rows.shape[1])
+        for function, values in zip(functions, state.reshape(len(functions), -1)):
+            function.x.array[dofs] = phi_rows @ values
+        expected = pack()
+        for function in functions:
+            function.x.array[:] = 0.0
+        if not np.allclose(self.packed(state), expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max()):
+            raise ValueError("the packed coefficients are not the functions' values at the dofs")
+
+    def packed(self, state: np.ndarray) -> np.ndarray:
+        """The cells' packed coefficients at a reduced state (for checks; :meth:`assemble` forms them
+        compiled)."""
+        values = self.basis @ state.reshape(-1, self.basis.shape[1]).T  # (dofs, functions)
+        out = self.offset.copy()
+        out[self.rows] += values[self.row_dof, self.row_function]
+        return out
 
     def assemble(self, state: np.ndarray):
         """The assembled number, or the vector or matrix projected on [Phi] (cell by cell), at the reduced
         state of the functions stacked in one vector."""
-        return self.cells.projected(self.offset, self.rows, self.row_function, self.rows_map, state, self.basis)
+        return self.cells.projected(self.offset, self.rows, self.row_function, self.row_dof, state, self.basis)
 
 
 class TangentEntries:
