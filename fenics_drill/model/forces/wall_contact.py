@@ -218,16 +218,17 @@ def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_ax
 
 @kernel
 def _weighted_rows(flat, active, blocks):
-    """R^T and A R in single precision: R, the rows of (u, v, w, theta_x) of the dense [Phi] at the vertices
-    in contact, A the blocks of :func:`_contact_blocks`; the wall's tangent is R^T (A R)."""
+    """R and A R in single precision: R, the rows of (u, v, w, theta_x) of the dense [Phi] at the vertices
+    in contact, A the blocks of :func:`_contact_blocks`; the wall's tangent is R^T (A R), one BLAS product
+    that reads R transposed in place."""
     size = flat.shape[1]
-    transposed = np.empty((size, 4 * active.size), dtype=np.float32)
+    rows = np.empty((4 * active.size, size), dtype=np.float32)
     weighted = np.zeros((4 * active.size, size), dtype=np.float32)
     for k in range(active.size):
         for f in range(4):
             source = 4 * active[k] + f
             for j in range(size):
-                transposed[j, 4 * k + f] = flat[source, j]
+                rows[4 * k + f, j] = flat[source, j]
         for o in range(4):
             for f in range(4):
                 a = blocks[k, o, f]
@@ -235,28 +236,43 @@ def _weighted_rows(flat, active, blocks):
                     source = 4 * active[k] + f
                     for j in range(size):
                         weighted[4 * k + o, j] += a * flat[source, j]
-    return transposed, weighted
+    return rows, weighted
 
 
 @kernel
 def _moved_blocks(vertices, blocks, kept, tolerance):
     """The vertices whose block moved by more than ``tolerance`` times the largest block, (vertex, field,
     field) ``kept`` against the ``blocks`` of the ``vertices`` in contact (zero elsewhere): their indices,
-    the increments of their blocks, and the kept blocks with theirs replaced."""
-    current = np.zeros_like(kept)
+    the increments of their blocks, and the kept blocks with theirs replaced.  Scalar loops, without
+    temporaries or views: it runs at every wall tangent."""
+    n, fields = kept.shape[0], kept.shape[1]
+    at = np.full(n, -1)  # each vertex's block among ``blocks`` (-1: out of contact, a zero block)
     for k in range(vertices.size):
-        current[vertices[k]] = blocks[k]
-    scale = max(np.abs(current).max(), np.abs(kept).max())
-    moved = np.zeros(kept.shape[0], dtype=np.bool_)
-    for i in range(kept.shape[0]):
-        moved[i] = np.abs(current[i] - kept[i]).max() > tolerance * scale
+        at[vertices[k]] = k
+    scale = 0.0
+    for value in kept.reshape(-1):
+        scale = max(scale, abs(value))
+    for value in blocks.reshape(-1):
+        scale = max(scale, abs(value))
+    limit = tolerance * scale
+    moved = np.zeros(n, dtype=np.bool_)
+    for i in range(n):
+        k = at[i]
+        for a in range(fields):
+            for b in range(fields):
+                if abs((blocks[k, a, b] if k >= 0 else 0.0) - kept[i, a, b]) > limit:
+                    moved[i] = True
     changed = np.flatnonzero(moved)
-    increments = np.empty((changed.size, kept.shape[1], kept.shape[2]))
+    increments = np.empty((changed.size, fields, fields))
     updated = kept.copy()
-    for k in range(changed.size):
-        i = changed[k]
-        increments[k] = current[i] - kept[i]
-        updated[i] = current[i]
+    for j in range(changed.size):
+        i = changed[j]
+        k = at[i]
+        for a in range(fields):
+            for b in range(fields):
+                current = blocks[k, a, b] if k >= 0 else 0.0
+                increments[j, a, b] = current - kept[i, a, b]
+                updated[i, a, b] = current
     return changed, increments, updated
 
 
@@ -528,7 +544,7 @@ class WallContact:
             return self._updated_tangent(vertices, blocks)
         kept_blocks = moved_blocks
         if changed.size:
-            transposed, weighted = _weighted_rows(self.flat, changed, increments)
-            matrix = matrix + (transposed @ weighted).astype(float)
+            rows, weighted = _weighted_rows(self.flat, changed, increments)
+            matrix = matrix + (rows.T @ weighted).astype(float)
         self._kept_tangent = (matrix, kept_blocks, updates + 1)
         return matrix
