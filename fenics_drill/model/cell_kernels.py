@@ -102,8 +102,18 @@ def _assemble_cells_at(address, offset, rows, row_function, row_dof, state, cons
     entry ``rows[i]`` of the packed array is the value of function ``row_function[i]`` (its reduced values are
     that slice of ``state``) at dof ``row_dof[i]``, row ``row_dof[i]`` of ``basis`` times them; the result
     projected on ``basis`` if ``projected`` (a vector or matrix), else summed as it is (a number)."""
-    functions, n = state.size // basis.shape[1], basis.shape[1]
-    values = np.dot(basis, np.ascontiguousarray(state.reshape(functions, n).T))  # (dofs, functions)
+    n = basis.shape[1]
+    padded = np.zeros(3 * n)  # the state of one to three functions (U; U, V; U, V, A)
+    padded[:state.size] = state
+    values = np.empty((basis.shape[0], 3))  # (dofs, functions): one pass over the rows, three sums at a time
+    for d in range(basis.shape[0]):         # (BLAS is slower for so few columns)
+        u = v = a = 0.0
+        for j in range(n):
+            b = basis[d, j]
+            u += b * padded[j]
+            v += b * padded[n + j]
+            a += b * padded[2 * n + j]
+        values[d, 0], values[d, 1], values[d, 2] = u, v, a
     packed = offset.copy()
     for i in range(rows.size):
         packed[rows[i]] += values[row_dof[i], row_function[i]]
