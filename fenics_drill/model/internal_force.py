@@ -131,6 +131,10 @@ class AssembledInternalForce:
     with projected matrices and only the nonlinear remainder (-F_KE - F_SE, Eqs. 48-49) is assembled,
     on the sampled cells with their weights: the weighted sum of the element energies, so the forces
     stay the gradients of an energy and the budget still closes (Farhat et al. 2014).
+
+    A modal space's force and energies come from the cells' kernels (:class:`SampledCoefficients`: all
+    cells, or the sample's), a third faster than DOLFINx's assembly and projection over all cells; its
+    tangents over all cells, and everything of the full order, through DOLFINx.
     """
 
     def __init__(self, disc: BeamDiscretization, space, operators: LinearOperators,
@@ -144,6 +148,10 @@ class AssembledInternalForce:
                                                                        forms.jacobians)
         # the dofs of the sampled cells: the only ones their kernels read
         self.dofs = None if sample is None else np.unique(disc.V.dofmap.list[sample.cells]).astype(PETSc.IntType)
+        # the cells whose kernels a modal space's force runs on, and their dofs (None: DOLFINx's assembly)
+        self._kernel_cells = None if space.sparse else (
+            (sample.cells, self.dofs) if sample is not None else
+            (np.arange(disc.elements, dtype=np.int32), np.arange(disc.ndofs)))
         self._vector = fem_petsc.create_vector(self._residual.function_spaces)
         if sample is None:  # DOLFINx's own CSR matrices, read at the entries that matter
             self._matrices = tuple(TangentEntries(form, space, forms.functions) if form is not None
@@ -159,12 +167,15 @@ class AssembledInternalForce:
         self._state = None
 
     def _sampled(self, form: fem.Form, functions) -> "SampledCoefficients":
-        self.weight.x.array[:] = 0.0  # the forms' weight is shared: this sample's is set where it is packed
-        self.weight.x.array[self.sample.cells] = self.sample.weights
-        return SampledCoefficients(form, functions, self.dofs, self.phi_rows, self.sample.cells)
+        cells, dofs = self._kernel_cells
+        if self.sample is not None:  # the forms' weight is shared: this sample's is set where it is packed
+            self.weight.x.array[:] = 0.0
+            self.weight.x.array[cells] = self.sample.weights
+        return SampledCoefficients(form, functions, dofs, self.space.phi if self.sample is None else self.phi_rows,
+                                   cells)
 
-    # the sampled forms' coefficient maps, built on first use (a trainer of the sample assembles through
-    # DOLFINx and never needs them)
+    # the cells' kernels of the forms, built on first use (a trainer of a sample assembles through DOLFINx and
+    # never needs them)
     @functools.cached_property
     def _packing(self) -> "SampledCoefficients":
         return self._sampled(self._residual, (self.U, self.V, self.A))
@@ -201,9 +212,11 @@ class AssembledInternalForce:
 
     def evaluate(self, q, qd, qdd) -> np.ndarray:
         self._state = (q, qd, qdd)
-        if self.dofs is None:
+        if self._kernel_cells is None:
             return self.space.project(self.assembled_vector(q, qd, qdd))
         state = np.concatenate((q, qd, qdd))
+        if self.sample is None:
+            return self._packing.assemble(state)
         return self._linear_rows @ state + self._packing.assemble(state)
 
     state_dependent = True
@@ -226,17 +239,19 @@ class AssembledInternalForce:
         return tuple(self._part(k) if want else None for k, want in enumerate(needed))
 
     def kinetic_energy(self, q, qd) -> float:
-        if self.dofs is not None:
-            return self._kinetic_cells.assemble(np.concatenate((q, qd))) + 0.5 * float(qd @ (self.linear[2] @ qd))
-        self._set(self.U, q)
-        self._set(self.V, qd)
-        return fem.assemble_scalar(self._kinetic)
+        if self._kernel_cells is None:
+            self._set(self.U, q)
+            self._set(self.V, qd)
+            return fem.assemble_scalar(self._kinetic)
+        energy = self._kinetic_cells.assemble(np.concatenate((q, qd)))
+        return energy if self.sample is None else energy + 0.5 * float(qd @ (self.linear[2] @ qd))
 
     def strain_energy(self, q) -> float:
-        if self.dofs is not None:
-            return self._strain_cells.assemble(q) + 0.5 * float(q @ (self.linear[0] @ q))
-        self._set(self.U, q)
-        return fem.assemble_scalar(self._strain)
+        if self._kernel_cells is None:
+            self._set(self.U, q)
+            return fem.assemble_scalar(self._strain)
+        energy = self._strain_cells.assemble(q)
+        return energy if self.sample is None else energy + 0.5 * float(q @ (self.linear[0] @ q))
 
     def damping_force(self, qd) -> np.ndarray:
         return self._damping @ qd
