@@ -32,7 +32,7 @@ from fenics_drill.scene import LAW_SIGN
 FIELDS = (U_FIELD, V_FIELD, W_FIELD, TX_FIELD)  # the fields the wall acts on: F_a, F_v, F_w, T_FS
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _damper(delta, delta_rate, damping, printed):
     """The damper of (17) at one vertex and its derivatives (F_d, dF_d/d delta, dF_d/d delta_dot)."""
     if printed:
@@ -42,7 +42,7 @@ def _damper(delta, delta_rate, damping, printed):
     return -damping * cubed * delta_rate, -3.0 * damping * delta * delta * delta_rate, -damping * cubed
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _normal_force(delta, delta_rate, stiffness_linear, stiffness_cubic, damping, printed):
     """Radial force (17) at one vertex: zero out of contact, and clipped at zero."""
     if delta <= 0.0:
@@ -52,7 +52,7 @@ def _normal_force(delta, delta_rate, stiffness_linear, stiffness_cubic, damping,
     return min(force, 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _regularised_sign(x, velocity_scale):
     """tanh(x / velocity_scale): Coulomb's sgn, smoothed so Newton can converge."""
     return np.tanh(x / velocity_scale)
@@ -80,7 +80,7 @@ _DAMPER = np.vectorize(_damper, otypes=(float, float, float))
 _NORMAL_FORCE = np.vectorize(_normal_force, otypes=(float,))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _friction(normal_force, axial_velocity, spin_rate, friction, torque_friction, borehole_radius, velocity_scale):
     """(18) and (19) at one vertex: -mu |F_n| sgn(u_dot) and -mu_T |F_n| R_bh sgn(R_bh theta_x_dot)."""
     magnitude = abs(normal_force)
@@ -105,10 +105,11 @@ def wall_friction(normal_force, axial_velocity, spin_rate, friction, borehole_ra
 _FRICTION = np.vectorize(_friction, otypes=(float, float))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s, delta, nodal,
                 laws):
-    """Eqs. (16)-(19) at vertex i with lateral position (v, w) and rates (u, v, w, theta_x)_dot: its
+    """Eqs. (16)-(19) at vertex i with lateral position (v, w) and rates (u, v, w, theta_x)_dot (row i of
+    ``rates``, read in place: a row view per vertex costs more than the law out of contact): its
     indentation, nodal loads and the loads of each law; returns the springs' energy."""
     r = np.hypot(v, w)
     d = r - gap
@@ -116,8 +117,8 @@ def _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torq
     if d <= 0.0:
         return 0.0
     n_v, n_w = v / r, w / r
-    normal = _normal_force(d, n_v * rates[1] + n_w * rates[2], k1, k2, damping, printed)
-    axial, torque = _friction(normal, rates[0], rates[3], mu_axial, mu_torque, radius_bh, v_s)
+    normal = _normal_force(d, n_v * rates[i, 1] + n_w * rates[i, 2], k1, k2, damping, printed)
+    axial, torque = _friction(normal, rates[i, 0], rates[i, 3], mu_axial, mu_torque, radius_bh, v_s)
     nodal[i, 0], nodal[i, 1], nodal[i, 2], nodal[i, 3] = axial, normal * n_v, normal * n_w, torque
     damper = normal + k1 * d + k2 * d**3  # with the clip that keeps the wall from pulling
     laws[i, 1, 0], laws[i, 2, 0] = damper * n_v, damper * n_w
@@ -134,7 +135,7 @@ def _vertex_loads(lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_to
     delta, nodal, laws = np.empty(n), np.zeros((n, 4)), np.zeros((n, 4, 3))
     potential = 0.0
     for i in range(n):
-        potential += _vertex_law(i, lateral[i, 0], lateral[i, 1], rates[i], gap, k1, k2, damping, printed,
+        potential += _vertex_law(i, lateral[i, 0], lateral[i, 1], rates, gap, k1, k2, damping, printed,
                                  mu_axial, mu_torque, radius_bh, v_s, delta, nodal, laws)
     return delta, nodal, laws, potential
 
@@ -163,7 +164,7 @@ def _modal_pass(flat, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque,
             r3 += flat[base + 3, j] * qd[j]
         lateral[i, 0], lateral[i, 1] = v, w
         rates[i, 0], rates[i, 1], rates[i, 2], rates[i, 3] = r0, r1, r2, r3
-        potential += _vertex_law(i, v, w, rates[i], gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh,
+        potential += _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh,
                                  v_s, delta, nodal, laws)
         if delta[i] > 0.0:
             axial, load_v, load_w, torque = nodal[i, 0], nodal[i, 1], nodal[i, 2], nodal[i, 3]
