@@ -62,15 +62,10 @@ def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, s
         elif modes == 0:
             for k in range(n):
                 out[cell_dofs[c, k]] += element[k]
-        elif square:
-            for k in range(n):  # K_c P_c, and P_c, along the rows of [Phi]
-                row = c * n + k
-                weighted[row, :] = 0.0
-                for m in range(n):
-                    value, dof = element[k * n + m], cell_dofs[c, m]
-                    for j in range(modes):
-                        weighted[row, j] += value * basis[dof, j]
-                rows[row, :] = basis[cell_dofs[c, k], :]
+        elif square:  # P_c, the rows of [Phi] at the cell's dofs, and K_c P_c (BLAS: a loop stores every sum)
+            for k in range(n):
+                rows[c * n + k, :] = basis[cell_dofs[c, k], :]
+            weighted[c * n:(c + 1) * n, :] = np.dot(element.reshape(n, n), rows[c * n:(c + 1) * n, :])
         else:
             for k in range(n):
                 value, row = element[k], cell_dofs[c, k]
