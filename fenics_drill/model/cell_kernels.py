@@ -48,7 +48,7 @@ def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, s
     element = np.empty(n * n if square else n)
     # a projected matrix: K_c P_c and P_c of every cell stacked, and P^T (K P) as one BLAS product at the end
     stacked = cell_dofs.shape[0] * n if square and modes > 0 else 0
-    weighted, rows = np.empty((stacked, modes)), np.empty((stacked, modes))
+    weighted, rows, cell_rows = np.empty((stacked, modes)), np.empty((stacked, modes)), np.empty((n, modes))
     entity, permutation = np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
     for c in range(cell_dofs.shape[0]):
         element[:] = 0.0
@@ -64,8 +64,9 @@ def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, s
                 out[cell_dofs[c, k]] += element[k]
         elif square:  # P_c, the rows of [Phi] at the cell's dofs, and K_c P_c (BLAS: a loop stores every sum)
             for k in range(n):
-                rows[c * n + k, :] = basis[cell_dofs[c, k], :]
-            weighted[c * n:(c + 1) * n, :] = np.dot(element.reshape(n, n), rows[c * n:(c + 1) * n, :])
+                cell_rows[k, :] = basis[cell_dofs[c, k], :]
+            rows[c * n:(c + 1) * n, :] = cell_rows
+            weighted[c * n:(c + 1) * n, :] = np.dot(element.reshape(n, n), cell_rows)
         else:
             for k in range(n):
                 value, row = element[k], cell_dofs[c, k]
