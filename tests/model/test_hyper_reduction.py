@@ -74,11 +74,16 @@ def test_a_modal_models_force_and_energies_from_the_cells_kernels_are_dolfinxs_a
     internal = model.internal
     for q, qd, qdd in states[5::40]:
         reference = model.space.project(internal.assembled_vector(q, qd, qdd))
+        # the same element vectors, projected cell by cell instead of after assembly: each entry sums ~6000
+        # products in another order (Higham: n eps ~ 1.3e-12 of the sum of magnitudes), so 1e-11 of the
+        # largest entry; a misplaced coefficient would be wrong at the size of the entry itself
         np.testing.assert_allclose(internal.evaluate(q, qd, qdd), reference, rtol=0,
                                    atol=1e-11 * np.abs(reference).max())
         kinetic, strain = internal.kinetic_energy(q, qd), internal.strain_energy(q)
         for function, values in zip((internal.U, internal.V), (q, qd)):
             function.x.array[:] = model.space.expand(values)
+        # 40 cell integrals summed in another order, from dof values formed by another product with [Phi]
+        # (59-term sums): round-off far below 1e-11 of energies that are all of one sign per cell
         assert kinetic == pytest.approx(fem.assemble_scalar(internal._kinetic), rel=1e-11)
         assert strain == pytest.approx(fem.assemble_scalar(internal._strain), rel=1e-11)
 
