@@ -207,6 +207,14 @@ class CellAssembly:
                                             self.constants, self.coordinates, self.cell_dofs, self.size,
                                             self.rank == 2, np.empty((self.size, 0))))
 
+    def element_tensors(self, coefficients: np.ndarray) -> np.ndarray:
+        """Each cell's element tensor (cells x its size: 1, the cell's dofs, or their square, row-major) from
+        the cells' packed coefficients."""
+        n = self.cell_dofs.shape[1]
+        size = n * n if self.rank == 2 else (n if self.rank == 1 else 1)
+        packed = np.ascontiguousarray(coefficients, dtype=float).reshape(len(self.coordinates), -1)
+        return _tabulate_cells(self.address, packed, self.constants, self.coordinates, size)
+
     def projected(self, offset, rows, row_function, row_dof, state, basis):
         """The number, or the vector or matrix projected on ``basis`` (the rows of [Phi] at the dofs:
         P^T f, P^T K P), from the packed coefficients ``offset`` plus, at ``rows``, the values at the dofs

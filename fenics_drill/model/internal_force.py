@@ -210,6 +210,11 @@ class AssembledInternalForce:
         fem_petsc.assemble_vector(self._vector, self._residual)
         return self._vector.array
 
+    def element_vectors(self, q, qd, qdd) -> np.ndarray:
+        """Each sampled cell's element vector of the residual form, weighted, in the order of its dofs
+        (cells x dofs per cell): what the ECSW trainer projects element by element."""
+        return self._packing.element_tensors(np.concatenate((q, qd, qdd)))
+
     def evaluate(self, q, qd, qdd) -> np.ndarray:
         self._state = (q, qd, qdd)
         if self._kernel_cells is None:
@@ -315,6 +320,10 @@ class SampledCoefficients:
         out = self.offset.copy()
         out[self.rows] += values[self.row_dof, self.row_function]
         return out
+
+    def element_tensors(self, state: np.ndarray) -> np.ndarray:
+        """Each cell's element tensor at a reduced state (cells x tensor size), as its kernel gives it."""
+        return self.cells.element_tensors(self.packed(state))
 
     def assemble(self, state: np.ndarray):
         """The assembled number, or the vector or matrix projected on [Phi] (cell by cell), at the reduced

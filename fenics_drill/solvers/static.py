@@ -17,10 +17,15 @@ import numpy as np
 from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.solvers.newton import saddle_newton
 
-#: Contact stiffness continuation: the wall springs are scaled by these factors in turn,
-#: each stage starting from the previous equilibrium (10^-4 to 1 in steps of 10^0.25).  A soft wall lets the string settle
-#: onto it smoothly; stiffening then moves it by tiny amounts Newton handles well.
-STIFFNESS_STAGES = tuple(10.0 ** (-0.25 * k) for k in range(16, -1, -1))
+#: Contact stiffness continuation: the wall springs are scaled by 10^s, s rising from FIRST_STAGE to 0 in steps
+#: of STAGE_STEP decades, each stage starting from the previous equilibrium.  A soft wall lets the string
+#: settle onto it smoothly; stiffening then moves it by amounts Newton handles well.  A stage whose Newton does
+#: not converge within STAGE_ITERATIONS (the last, with the real wall: the solve's ``max_iterations``) is tried again from the last equilibrium with half the step, down to
+#: SMALLEST_STAGE_STEP (a long string on a stiff wall); after a success the step doubles again, up to STAGE_STEP.
+FIRST_STAGE = -4.0
+STAGE_STEP = 1.0
+SMALLEST_STAGE_STEP = 1.0 / 64
+STAGE_ITERATIONS = 40
 
 #: Largest lateral move of any vertex per Newton update, as a fraction of the gap.
 STEP_LIMIT = 0.25
@@ -50,7 +55,7 @@ def solve_static(model: DrillstringModel, tolerance: float = 1e-8, max_iteration
     """Equilibrium of the string at rest (velocities zero, so no friction and no bit-rock force).
 
     From the straight string with wall contact, the wall springs are stiffened stage by stage
-    (:data:`STIFFNESS_STAGES`) on copies of the model; the model itself is left as it was.  From an
+    (:data:`FIRST_STAGE`, :data:`STAGE_STEP`) on copies of the model; the model itself is left as it was.  From an
     ``initial`` guess near the equilibrium (the full-order state projected on a reduced basis), one
     Newton solve with the real wall."""
     model = model.at_rest()  # both drive dofs held, whatever drives the run
@@ -58,13 +63,25 @@ def solve_static(model: DrillstringModel, tolerance: float = 1e-8, max_iteration
     wall = model.force("wall")
     if wall is None or initial is not None:
         return _newton(model, q, mu, tolerance, max_iterations)
-    iterations = 0
-    for factor in STIFFNESS_STAGES:
-        stage = model.with_force(wall.with_stiffness_scale(factor))
-        eq = _newton(stage, q, mu, tolerance if factor == 1.0 else 1e-6, max_iterations)
+    exponent, step, iterations = FIRST_STAGE, STAGE_STEP, 0
+    # the first stage starts from the straight string: it may take all the iterations it is allowed
+    eq = _newton(model.with_force(wall.with_stiffness_scale(10.0 ** exponent)), q, mu, 1e-6, max_iterations)
+    while True:
         q, mu, iterations = eq.q, eq.mu, iterations + eq.iterations
-    return StaticEquilibrium(q, mu, iterations, eq.residual)
-
+        if exponent == 0.0:
+            return StaticEquilibrium(q, mu, iterations, eq.residual)
+        while True:
+            trial = min(exponent + step, 0.0)
+            stage = model.with_force(wall.with_stiffness_scale(10.0 ** trial))
+            try:
+                eq = _newton(stage, q, mu, 1e-6, STAGE_ITERATIONS) if trial < 0.0 else \
+                    _newton(stage, q, mu, tolerance, max_iterations)
+                break
+            except StaticFailure:
+                step *= 0.5
+                if step < SMALLEST_STAGE_STEP:
+                    raise
+        exponent, step = trial, min(2.0 * step, STAGE_STEP)
 
 def _newton(model: DrillstringModel, q, mu, tolerance: float, max_iterations: int) -> StaticEquilibrium:
     zero = np.zeros(model.size)

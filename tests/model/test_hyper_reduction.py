@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from conftest import scene_with
 
-from fenics_drill.model.hyper_reduction import ElementSample, sampling_error, sparse_nnls, spin_shift, train_sample
+from fenics_drill.model.hyper_reduction import (ElementSample, element_forces, sampling_error, sparse_nnls, spin_shift,
+                                                 train_sample)
 from fenics_drill.model.internal_force import AssembledInternalForce
 from fenics_drill.solvers.time_loop import Simulation
 from fenics_drill.studies.prepare import prepare
@@ -86,6 +87,25 @@ def test_a_modal_models_force_and_energies_from_the_cells_kernels_are_dolfinxs_a
         # (59-term sums): round-off far below 1e-11 of energies that are all of one sign per cell
         assert kinetic == pytest.approx(fem.assemble_scalar(internal._kinetic), rel=1e-11)
         assert strain == pytest.approx(fem.assemble_scalar(internal._strain), rel=1e-11)
+
+
+def test_the_trainers_element_forces_are_each_elements_assembled_and_projected_force(drilling):
+    """ECSW's matrix G holds [Phi_e]^T f_nl,e of each element from the elements' kernels; the reference is
+    DOLFINx's assembly of the nonlinear remainder with the weight 1 on one element (every third element)
+    and 0 elsewhere, projected with the whole [Phi].  The same element integral in both, projected by
+    12-term sums in another order: 1e-12 of the largest entry; a wrong placement or weight is of its size."""
+    scene, model, states = drilling
+    q, qd, qdd = states[len(states) // 2]
+    G = element_forces(model.disc, model.space, model.operators, switches(scene), [(q, qd, qdd)])
+    cells = np.arange(model.disc.elements, dtype=np.int32)
+    trainer = AssembledInternalForce(model.disc, model.space, model.operators, *switches(scene),
+                                     sample=ElementSample(cells, np.ones(cells.size)))
+    for e in cells[::3]:
+        trainer.weight.x.array[:] = 0.0
+        trainer.weight.x.array[e] = 1.0
+        reference = model.space.project(trainer.assembled_vector(q, qd, qdd))
+        np.testing.assert_allclose(G[:, e], reference, rtol=0, atol=1e-12 * np.abs(G).max())
+    assert np.abs(G).max() > 0
 
 
 def test_a_trained_sample_is_within_its_bound_on_random_states_and_its_tangent_is_its_own(drilling):

@@ -12,6 +12,7 @@ from fenics_drill.model.drillstring import build_model
 from fenics_drill.model.internal_force import LinearInternalForce
 from fenics_drill.model.operators import assemble_linear
 from fenics_drill.solvers.newmark import State
+from fenics_drill.solvers import static
 from fenics_drill.solvers.static import solve_static, static_report
 from fenics_drill.solvers.time_loop import Simulation
 
@@ -73,6 +74,22 @@ def test_string_rests_on_the_wall_with_the_penetration_of_k_fs1_and_the_lift_off
     assert np.allclose(k1 * delta + k2 * delta**3, q * h, rtol=1e-3)
     # sag = gap + penetration (~1e-7 m): 1e-4 of the gap bounds the penetration at 1.5 micrometres
     assert report["max_sag"] == pytest.approx(model.gap, rel=1e-4)
+
+
+def test_stiffness_continuation_that_halves_its_stages_reaches_the_same_equilibrium(monkeypatch):
+    """A stage whose Newton fails is retried from the last equilibrium with half the step: forcing every
+    stage to fail at a full decade (3 iterations allowed) must lead, through halved stages, to the
+    equilibrium of the default continuation, the string resting on the wall."""
+    model = build_model(scene_with("beam.elements=100", "reduction.rule='none'", "model.bit_rock=false"))
+    default = solve_static(model)
+    monkeypatch.setattr(static, "STAGE_ITERATIONS", 3)
+    halved = solve_static(model)
+    assert halved.iterations > default.iterations  # the failed stages were retried
+    # both are Newton's equilibria to 1e-8 of the forces; 1e-6 of the state's size leaves room for the
+    # conditioning of the stiff wall against the bending stiffness, while another contact set would differ by
+    # a share of the gap, which the sag is made of
+    assert np.max(np.abs(halved.q - default.q)) <= 1e-6 * np.max(np.abs(default.q))
+    assert static_report(model, halved)["max_sag"] == pytest.approx(model.gap, rel=1e-4)
 
 
 def _free_vibration(scene, amplitude=1e-3, periods=6, steps_per_period=60):
