@@ -88,13 +88,17 @@ def _with_element_sample(model: DrillstringModel, scene, equilibrium: StaticEqui
     first = [(start.q, start.qd, start.qdd)]
     sample, report = train_sample(model.disc, model.space, model.operators, switches, first,
                                   scene.reduction.hyper_tolerance)
-    simulation = Simulation(model.with_sample(sample, report, first), scene, energy_budget=False)
-    states = []
-    try:
-        simulation.run(simulation.initial_state(equilibrium.q), horizon,
-                       lambda r: states.append((r.state.q, r.state.qd, r.state.qdd)))
-    except StepTooSmall as failure:
-        model.hyper_reduction = {"elements": None, "message": f"training run failed, all elements kept: {failure}"}
+    for trainer in (model.with_sample(sample, report, first), model):  # the unsampled run if the sampled fails
+        simulation = Simulation(trainer, scene, energy_budget=False)
+        states = []
+        try:
+            simulation.run(simulation.initial_state(equilibrium.q), horizon,
+                           lambda r: states.append((r.state.q, r.state.qd, r.state.qdd)))
+            break
+        except StepTooSmall as failure:
+            message = f"training run failed, all elements kept: {failure}"
+    else:
+        model.hyper_reduction = {"elements": None, "message": message}
         return model
     chosen = np.unique(np.linspace(0, len(states) - 1, TRAINING_STATES).round().astype(int))
     training = [states[i] for i in chosen]

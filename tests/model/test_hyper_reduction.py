@@ -156,6 +156,30 @@ def test_the_sample_trained_on_the_sampled_training_run_is_as_good_as_one_traine
     assert largest_error(prepared.model.internal) <= 1.5 * largest_error(reference)
 
 
+def test_a_failed_sampled_training_run_is_run_again_unsampled(monkeypatch):
+    """If the sampled training run collapses (StepTooSmall), the unsampled model runs it and the sample is
+    trained on its states: a sample within its training tolerance, not the whole mesh kept."""
+    import fenics_drill.studies.prepare as prepare_module
+    from fenics_drill.solvers.step_control import StepTooSmall
+
+    scene = scene_with(*STRING, "time.t_end=0.3")
+    run = prepare_module.Simulation.run
+    ran_unsampled = []
+
+    def failing_when_sampled(self, *args, **kwargs):
+        if self.model.exact_internal is not None:
+            raise StepTooSmall("forced")
+        ran_unsampled.append(True)
+        return run(self, *args, **kwargs)
+
+    monkeypatch.setattr(prepare_module.Simulation, "run", failing_when_sampled)
+    prepared = prepare(scene)
+    assert ran_unsampled
+    report = prepared.model.hyper_reduction
+    assert report["elements"] is not None and report["elements"] < prepared.model.disc.elements / 2
+    assert report["training_error"] <= 1e-4
+
+
 def run_quantities(*extra):
     from fenics_drill.studies.prepare import run_realisation
 
