@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 from petsc4py import PETSc
 from slepc4py import SLEPc
 
@@ -223,20 +224,43 @@ def _field_modes(disc: BeamDiscretization, field: int, held_ends: tuple, f_star_
                  kind: str) -> ModalBasis:
     """The modes of one field's block of (62) up to ``f_star_max``, with the field held at ``held_ends``
     (0: x = 0, 1: x = L) and at the supports.  The linear operators (46) couple neither u nor theta_x with
-    any other field, so their blocks alone give their modes (dense, a few hundred dofs)."""
+    any other field, so their blocks alone give their modes (:func:`_lowest_pairs`)."""
     p = disc.properties
     held = [disc.end_dof(field, end) for end in held_ends]
     inner = np.setdiff1d(disc.field_dofs[field], np.concatenate([held, disc.support_dofs]).astype(int))
-    K = sp.csr_matrix(stiffness)[inner][:, inner].toarray()
-    M = sp.csr_matrix(mass)[inner][:, inner].toarray()
+    K = sp.csc_matrix(sp.csr_matrix(stiffness)[inner][:, inner])
+    M = sp.csc_matrix(sp.csr_matrix(mass)[inner][:, inner])
     omega_max = 2.0 * math.pi * f_star_max * p.longitudinal_wave_speed / p.length
-    eigenvalues, block = sla.eigh(K, M, subset_by_value=(0.0, omega_max**2))
+    eigenvalues, block = _lowest_pairs(K, M, omega_max**2)
     vectors = np.zeros((disc.ndofs, eigenvalues.size))
-    vectors[inner] = block  # M-orthonormal: eigh normalises block^T M block = I
+    vectors[inner] = block  # M-orthonormal: both solvers normalise block^T M block = I
     freqs = np.sqrt(eigenvalues) / (2.0 * math.pi)
     fractions = field_mass_fractions(mass, disc.field_of_dof, vectors)
     return ModalBasis(freqs, freqs * p.length / p.longitudinal_wave_speed, [kind] * eigenvalues.size,
                       fractions, vectors)
+
+
+#: Systems up to this size are solved dense (LAPACK's eigh); larger ones by shift-and-invert Lanczos.
+DENSE_BLOCK = 200
+
+
+def _lowest_pairs(K: sp.spmatrix, M: sp.spmatrix, largest: float) -> tuple[np.ndarray, np.ndarray]:
+    """The eigenpairs K x = lambda M x with lambda <= ``largest`` of a positive definite K (a held bar's
+    block: tridiagonal for P1), ascending, M-orthonormal.  Shift-and-invert Lanczos about 0 (ARPACK, one
+    sparse LU) for as many pairs as the band may hold, doubled until one lies above it: a dense eigensolve
+    of the block costs O(n^3) for the handful of modes wanted."""
+    n = K.shape[0]
+    if n <= DENSE_BLOCK:
+        return sla.eigh(K.toarray(), M.toarray(), subset_by_value=(0.0, largest))
+    wanted = 8
+    while True:
+        values, vectors = spla.eigsh(K, min(wanted, n - 2), M, sigma=0.0, which="LM")
+        order = np.argsort(values)
+        values, vectors = values[order], vectors[:, order]
+        if values[-1] > largest or wanted >= n - 2:
+            keep = values <= largest
+            return values[keep], vectors[:, keep]
+        wanted *= 2
 
 
 def stuck_bit_modes(disc: BeamDiscretization, f_star_max: float, mass, stiffness) -> ModalBasis:

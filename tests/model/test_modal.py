@@ -7,6 +7,7 @@ import pytest
 from conftest import scene_with
 
 from fenics_drill.model.discretization import DRIVE, BeamDiscretization
+from fenics_drill.model import modes
 from fenics_drill.model.modes import auto_bands, drive_held_modes, paper_bands, solve_modes, stuck_bit_modes
 from fenics_drill.model.operators import assemble_linear
 from fenics_drill.studies.modal_report import modal_report
@@ -101,11 +102,15 @@ def test_modes_held_by_the_drive_are_the_fixed_free_quarter_waves():
     assert held.frequencies_hz[kinds == "torsional"][0] == pytest.approx(7.28, abs=0.01)
 
 
-def test_modes_held_by_the_drive_from_the_free_modes_and_two_blocks_are_the_whole_eigensolve():
+@pytest.mark.parametrize("dense_block", [modes.DENSE_BLOCK, 0], ids=["blocks dense", "blocks by Lanczos"])
+def test_modes_held_by_the_drive_from_the_free_modes_and_two_blocks_are_the_whole_eigensolve(dense_block,
+                                                                                             monkeypatch):
     """drive_held_modes (the free string's flexural modes, the axial and torsional blocks with u(0) and
     theta_x(0) held) gives the eigensolve of the whole string held by the drive: the same kinds in the same
     order and the same frequencies, to SLEPc's tolerance (1e-10 on the eigenpairs' residuals; 7e-12 measured
-    on the frequencies, held to 1e-9, well below any discretization error), on a string with supports."""
+    on the frequencies, held to 1e-9, well below any discretization error), on a string with supports;
+    with the blocks solved dense (LAPACK) and by shift-and-invert Lanczos (ARPACK), as larger blocks are."""
+    monkeypatch.setattr(modes, "DENSE_BLOCK", dense_block)
     scene = scene_with("beam.elements=60", "beam.length=30.0")
     disc = BeamDiscretization.from_scene(scene)
     operators = assemble_linear(disc)
@@ -117,7 +122,7 @@ def test_modes_held_by_the_drive_from_the_free_modes_and_two_blocks_are_the_whol
     # SLEPc converges the eigenpairs to a 1e-10 residual, so the two solves agree to about that (7.1e-12
     # measured); 1e-9 leaves room for it and is still far below any discretization error or wrong mode
     np.testing.assert_allclose(held.frequencies_hz, whole.frequencies_hz, rtol=1e-9)
-    # M-orthonormal: the blocks' vectors to round-off (dense eigh), against each other exactly (disjoint
+    # M-orthonormal: the blocks' vectors to round-off (both solvers normalise them), against each other exactly (disjoint
     # fields, which M does not couple); the flexural ones as SLEPc delivers them, whose degenerate v / w pairs
     # are orthogonal to about its 1e-10 residual tolerance (1.7e-10 and, with nev + 32 Krylov vectors,
     # 2.0e-10 measured), so 1e-9
