@@ -132,6 +132,30 @@ def _tabulate_cells(address, coefficients, constants, coordinates, size):
     return out
 
 
+@njit(cache=True)
+def tabulate_at_cells(address, dofs, cell_dofs, constants, coordinates, out):
+    """An expression of one function (block size 1) at every cell, into the rows of ``out`` (cells x its
+    values), from the function's dof values ``dofs``, gathered cell by cell (for kernels that evaluate it
+    for many states in one call)."""
+    local = np.empty(cell_dofs.shape[1])
+    entity, permutation = np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
+    for c in range(cell_dofs.shape[0]):
+        for k in range(cell_dofs.shape[1]):
+            local[k] = dofs[cell_dofs[c, k]]
+        out[c, :] = 0.0
+        _call_at(address, _FFI.from_buffer(out[c]), _FFI.from_buffer(local), _FFI.from_buffer(constants),
+                 _FFI.from_buffer(coordinates[c]), _FFI.from_buffer(entity), _FFI.from_buffer(permutation),
+                 _FFI.from_buffer(permutation))
+
+
+@kernel
+def _expression_at_cells(address, dofs, cell_dofs, constants, coordinates, size):
+    """:func:`tabulate_at_cells` into a new array."""
+    out = np.empty((cell_dofs.shape[0], size))
+    tabulate_at_cells(address, dofs, cell_dofs, constants, coordinates, out)
+    return out
+
+
 def _cell_coordinates(mesh, cells: np.ndarray) -> np.ndarray:
     """The coordinates of the geometry nodes of each cell, as the kernels take them (cells x nodes * 3)."""
     return np.ascontiguousarray(mesh.geometry.x[mesh.geometry.dofmaps[0][cells]].reshape(len(cells), -1))
@@ -155,8 +179,8 @@ class CellExpression:
 
     def __call__(self, dofs: np.ndarray) -> np.ndarray:
         """The expression at its points of every cell (cells x points * values)."""
-        return _tabulate_cells(self.address, np.ascontiguousarray(dofs[self.cell_dofs], dtype=float), self.constants,
-                               self.coordinates, self.size)
+        return _expression_at_cells(self.address, np.ascontiguousarray(dofs, dtype=float), self.cell_dofs,
+                                    self.constants, self.coordinates, self.size)
 
 
 class CellAssembly:

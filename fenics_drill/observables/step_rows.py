@@ -88,7 +88,8 @@ class StepRows:
         values = np.asarray(self.point_rows @ q.T).T.tolist()  # (steps, 5)
         rates = np.asarray(self.point_rows @ np.array([s.qd for s in states]).T).T.tolist()
         if self.stress is not None:
-            stresses = [self.stress.maximum(dofs) for dofs in self.model.space.expand_rows(q)]
+            largest, where = self.stress.maxima(self.model.space.expand_rows(q))
+            stresses = list(zip(largest.tolist(), where.tolist()))
         else:
             stresses = [(np.nan, np.nan)] * len(states)
         rows = []

@@ -25,7 +25,7 @@ import ufl
 from dolfinx import fem
 from numba import njit
 
-from fenics_drill.model.cell_kernels import CellExpression
+from fenics_drill.model.cell_kernels import CellExpression, tabulate_at_cells
 from fenics_drill.model.compiled import kernel
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.forms.energies import green_lagrange_strains, linear_strains, strain_slots
@@ -43,37 +43,78 @@ def _von_mises_squared(exx, exy, exz, young_modulus, shear_modulus):
     return young_modulus**2 * exx * exx + 12.0 * shear_modulus**2 * (exy * exy + exz * exz)
 
 
+@njit(cache=True, inline="always")
+def _sampled_at(c, p, monomials, young_modulus, shear_modulus):
+    """The largest sigma_VM^2 over the outer fibre's samples at point p, from the monomial coefficients ``c``
+    (points, 3 strains, 6 monomials) and the monomials at the samples (6, samples)."""
+    largest = 0.0
+    for s in range(monomials.shape[1]):
+        exx = exy = exz = 0.0
+        for m in range(monomials.shape[0]):
+            exx += c[p, 0, m] * monomials[m, s]
+            exy += c[p, 1, m] * monomials[m, s]
+            exz += c[p, 2, m] * monomials[m, s]
+        largest = max(largest, _von_mises_squared(exx, exy, exz, young_modulus, shear_modulus))
+    return largest
+
+
+@njit(cache=True, inline="always")
+def _bound_at(c, p, monomial_bounds, young_modulus, shear_modulus):
+    """An upper bound of sigma_VM^2 over the whole outer fibre at point p: each strain is bounded by the sum
+    of its monomials' largest magnitudes on the circle r = R_ext."""
+    exx = exy = exz = 0.0
+    for m in range(monomial_bounds.size):
+        exx += abs(c[p, 0, m]) * monomial_bounds[m]
+        exy += abs(c[p, 1, m]) * monomial_bounds[m]
+        exz += abs(c[p, 2, m]) * monomial_bounds[m]
+    return _von_mises_squared(exx, exy, exz, young_modulus, shear_modulus)
+
+
 @kernel
 def _sampled_maxima(c, points, monomials, young_modulus, shear_modulus):
-    """The largest sigma_VM^2 over the outer fibre's samples at each of ``points``, from the monomial
-    coefficients ``c`` (points, 3 strains, 6 monomials) and the monomials at the samples (6, samples)."""
+    """:func:`_sampled_at` at each of ``points``."""
     out = np.empty(points.size)
     for k in range(points.size):
-        p, largest = points[k], 0.0
-        for s in range(monomials.shape[1]):
-            exx = exy = exz = 0.0
-            for m in range(monomials.shape[0]):
-                exx += c[p, 0, m] * monomials[m, s]
-                exy += c[p, 1, m] * monomials[m, s]
-                exz += c[p, 2, m] * monomials[m, s]
-            largest = max(largest, _von_mises_squared(exx, exy, exz, young_modulus, shear_modulus))
-        out[k] = largest
+        out[k] = _sampled_at(c, points[k], monomials, young_modulus, shear_modulus)
     return out
+
+
+@njit(cache=True)
+def _largest(c, monomials, monomial_bounds, young_modulus, shear_modulus):
+    """(the largest sampled sigma_VM^2 over all points of ``c``, its point): the sections are sampled only
+    where the bound of :func:`_bound_at` reaches the stress sampled at the point of largest bound (NaN if
+    no bound does: a non-finite state)."""
+    n = c.shape[0]
+    bound = np.empty(n)
+    first = 0
+    for p in range(n):
+        bound[p] = _bound_at(c, p, monomial_bounds, young_modulus, shear_modulus)
+        if bound[p] > bound[first]:
+            first = p
+    # (1 - 1e-9): the bound and the sampled stress are equal where one monomial carries the strain, and
+    # round-off must not drop that section
+    reached = (1.0 - 1e-9) * _sampled_at(c, first, monomials, young_modulus, shear_modulus)
+    largest, at = np.nan, first
+    for p in range(n):
+        if bound[p] >= reached:
+            value = _sampled_at(c, p, monomials, young_modulus, shear_modulus)
+            if not value <= largest:  # the first of the largest (and any value beats NaN)
+                largest, at = value, p
+    return largest, at
 
 
 @kernel
-def _bounds(c, monomial_bounds, young_modulus, shear_modulus):
-    """An upper bound of sigma_VM^2 over the whole outer fibre at every point of ``c``: each strain is
-    bounded by the sum of its monomials' largest magnitudes on the circle r = R_ext."""
-    out = np.empty(c.shape[0])
-    for p in range(c.shape[0]):
-        exx = exy = exz = 0.0
-        for m in range(monomial_bounds.size):
-            exx += abs(c[p, 0, m]) * monomial_bounds[m]
-            exy += abs(c[p, 1, m]) * monomial_bounds[m]
-            exz += abs(c[p, 2, m]) * monomial_bounds[m]
-        out[p] = _von_mises_squared(exx, exy, exz, young_modulus, shear_modulus)
-    return out
+def _batch_maxima(address, dofs_rows, cell_dofs, constants, coordinates, size, monomials, monomial_bounds,
+                  young_modulus, shear_modulus):
+    """:func:`_largest` of each state (a row of ``dofs_rows``), its strains' coefficients from the expression
+    at ``address`` (:func:`~fenics_drill.model.cell_kernels.tabulate_at_cells`): one call for many steps."""
+    strains = np.empty((cell_dofs.shape[0], size))
+    values, at = np.empty(dofs_rows.shape[0]), np.empty(dofs_rows.shape[0], dtype=np.int64)
+    for s in range(dofs_rows.shape[0]):
+        tabulate_at_cells(address, dofs_rows[s], cell_dofs, constants, coordinates, strains)
+        values[s], at[s] = _largest(strains.reshape(-1, 3, monomials.shape[0]), monomials, monomial_bounds,
+                                    young_modulus, shear_modulus)
+    return values, at
 
 
 def outer_fibre(outer_radius: float, angles: int = SECTION_ANGLES) -> np.ndarray:
@@ -116,21 +157,22 @@ class VonMisesProbe:
         squared = _sampled_maxima(c, np.arange(len(c)), self.monomials, self.E, self.G)
         return np.sqrt(squared).reshape(len(self.cells), len(ELEMENT_POINTS))
 
-    def maximum(self, dofs: np.ndarray) -> tuple[float, float]:
-        """(max sigma_VM [Pa], x where it occurs [m]) over the whole string.
+    def maxima(self, dofs_rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(max sigma_VM [Pa], x where it occurs [m]) over the whole string for each row of ``dofs_rows``
+        (states x dofs), in one compiled call.
 
-        The same maximum as :meth:`stress`, at a fraction of its cost: the sections are sampled only
-        where the bound of :func:`_bounds` reaches the stress sampled at the section of largest bound."""
-        c = self._coefficients(dofs)
-        bound = _bounds(c, self.monomial_bounds, self.E, self.G)
-        first = np.array([np.argmax(bound)])
-        # (1 - 1e-9): the bound and the sampled stress are equal where one monomial carries the strain,
-        # and round-off must not drop that section
-        reached = (1.0 - 1e-9) * _sampled_maxima(c, first, self.monomials, self.E, self.G)[0]
-        candidates = np.flatnonzero(bound >= reached)
-        squared = _sampled_maxima(c, candidates, self.monomials, self.E, self.G)
-        k = int(candidates[np.argmax(squared)])
-        return float(np.sqrt(squared.max())), float(self.x.flat[k])
+        The same maxima as :meth:`stress`, at a fraction of its cost: the sections are sampled only where an
+        upper bound of the stress reaches the stress sampled at the section of largest bound."""
+        cells = self._at_cells
+        squared, at = _batch_maxima(cells.address, np.ascontiguousarray(dofs_rows, dtype=float), cells.cell_dofs,
+                                    cells.constants, cells.coordinates, cells.size, self.monomials,
+                                    self.monomial_bounds, self.E, self.G)
+        return np.sqrt(squared), self.x.ravel()[at]
+
+    def maximum(self, dofs: np.ndarray) -> tuple[float, float]:
+        """:meth:`maxima` of one state."""
+        values, where = self.maxima(np.asarray(dofs)[None, :])
+        return float(values[0]), float(where[0])
 
     def cell_stress(self, dofs: np.ndarray) -> np.ndarray:
         """Maximum of sigma_VM over each element (for field output and pictures) [Pa]."""

@@ -66,16 +66,19 @@ def test_von_mises_of_pure_bending_is_e_kappa_r_plus_the_green_lagrange_stretch(
 def test_the_pruned_maximum_is_the_maximum_over_every_sampled_section(disc):
     """maximum() samples only the sections whose bound reaches a sampled stress; on random states of
     every field (bending, torsion, shear, stretch mixed) it must find exactly what sampling every
-    section finds (the same arithmetic on the same points: equal to round-off)."""
+    section finds (the same arithmetic on the same points: equal to round-off), and maxima() of all the
+    states at once what maximum() finds for each."""
     rng = np.random.default_rng(7)
     probe = VonMisesProbe(disc)
-    for _ in range(20):
-        dofs = 1e-3 * rng.normal(size=disc.ndofs) * rng.uniform(0.0, 1.0, size=disc.ndofs) ** 4
+    states = [1e-3 * rng.normal(size=disc.ndofs) * rng.uniform(0.0, 1.0, size=disc.ndofs) ** 4 for _ in range(20)]
+    values, places = probe.maxima(np.array(states))  # all states in one call, as the step rows ask
+    for dofs, in_batch, batch_place in zip(states, values, places):
         value, where = probe.maximum(dofs)
         everywhere = probe.stress(dofs)
         k = int(np.argmax(everywhere))
         assert value == pytest.approx(everywhere.flat[k], rel=1e-14)
         assert where == probe.x.flat[k]
+        assert (in_batch, batch_place) == (value, where)  # the same arithmetic, state by state
 
 
 #: A threshold crossing is located to one sample: two crossings per period of 1000 samples.
