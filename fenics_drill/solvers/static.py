@@ -20,8 +20,9 @@ from fenics_drill.solvers.newton import saddle_newton
 #: Contact stiffness continuation: the wall springs are scaled by 10^s, s rising from FIRST_STAGE to 0 in steps
 #: of STAGE_STEP decades, each stage starting from the previous equilibrium.  A soft wall lets the string
 #: settle onto it smoothly; stiffening then moves it by amounts Newton handles well.  A stage whose Newton does
-#: not converge within STAGE_ITERATIONS (the last, with the real wall: the solve's ``max_iterations``) is tried again from the last equilibrium with half the step, down to
-#: SMALLEST_STAGE_STEP (a long string on a stiff wall); after a success the step doubles again, up to STAGE_STEP.
+#: not converge within STAGE_ITERATIONS (the last, with the real wall: the solve's ``max_iterations``) is
+#: tried again from the last equilibrium with half the step, down to SMALLEST_STAGE_STEP (a long string on a
+#: stiff wall); after a success the step doubles again, up to STAGE_STEP.
 FIRST_STAGE = -4.0
 STAGE_STEP = 1.0
 SMALLEST_STAGE_STEP = 1.0 / 64
