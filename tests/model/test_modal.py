@@ -127,9 +127,9 @@ def test_modes_held_by_the_drive_from_the_free_modes_and_two_blocks_are_the_whol
     # measured); 1e-9 leaves room for it and is still far below any discretization error or wrong mode
     np.testing.assert_allclose(held.frequencies_hz, whole.frequencies_hz, rtol=1e-9)
     # M-orthonormal: the blocks' vectors to round-off (both solvers normalise them), against each other
-    # exactly (disjoint fields, which M does not couple); the flexural ones as SLEPc delivers them, whose degenerate v / w pairs
-    # are orthogonal to about its 1e-10 residual tolerance (1.7e-10 and, with nev + 32 Krylov vectors,
-    # 2.0e-10 measured), so 1e-9
+    # exactly (disjoint fields, which M does not couple); the flexural ones as SLEPc delivers them, whose
+    # degenerate v / w pairs are orthogonal to about its 1e-10 residual tolerance (1.7e-10 and, with nev + 32
+    # Krylov vectors, 2.0e-10 measured), so 1e-9
     np.testing.assert_allclose(held.vectors.T @ operators.mass @ held.vectors, np.eye(len(held)), atol=1e-9)
 
 
