@@ -135,13 +135,16 @@ def axial_companions(disc: BeamDiscretization, statics: StaticSolver, vectors: n
     return statics.responses(loads)
 
 
-#: A vector that the basis already holds to within this share of its M-norm is not added.  The eigenvectors
-#: are known to about SLEPc's 1e-10 residual over the gap of their frequencies: what is left of a vector the
-#: basis holds better than 1e-6 can be mostly that error, a direction of noise that changes with round-off
-#: (a 10 m string's stuck-bit modes left 3.8e-9 or 7.7e-8 of one, with and without SLEPc's purification,
-#: and the basis had 31 or 32 vectors); the physical parts left are 3.7e-7 and more, equal to 7 digits whatever
-#: the eigensolver's round-off (1.2e-5 and more on the paper string, whose basis this tolerance leaves as it was).
-SPAN_TOLERANCE = 1e-6
+#: A vector whose part outside the basis is below this share of its M-norm is already in the span: the
+#: round-off of Gram-Schmidt on vectors known to about machine precision (static responses, the static state).
+SPAN_TOLERANCE = 1e-8
+#: The same for eigenvectors of another eigensolve (the stuck-bit modes augmented onto the free string's):
+#: they are known to about the eigensolver's 1e-10 residual over the gap of their frequencies, and below 1e-6
+#: what is left can be mostly that error, a direction of noise that changes with round-off (a 10 m string's
+#: stuck-bit modes left 3.8e-9 or 7.7e-8 of one, with and without SLEPc's purification, and the basis had 31
+#: or 32 vectors).  The physical parts left are 3.7e-7 and more there, equal to 7 digits whatever the round-off;
+#: on the paper string 1.2e-5 and more, so its basis is the same with either tolerance.
+MODE_SPAN_TOLERANCE = 1e-6
 
 
 def augment(phi: np.ndarray, vectors: np.ndarray, mass: sp.spmatrix, tolerance: float = SPAN_TOLERANCE) -> np.ndarray:

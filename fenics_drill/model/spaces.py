@@ -23,7 +23,7 @@ from scipy.linalg.lapack import dgetrs as getrs
 
 from fenics_drill.model.banded_saddle import BandedSaddle
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
-from fenics_drill.model.enrichment import augment, enrich
+from fenics_drill.model.enrichment import MODE_SPAN_TOLERANCE, augment, enrich
 from fenics_drill.model.modes import reduction_bands, select_modes, solve_modes, stuck_bit_modes
 from fenics_drill.model.operators import LinearOperators
 
@@ -293,7 +293,7 @@ def solution_space(scene, disc: BeamDiscretization, operators: LinearOperators):
     vectors, stuck = basis.vectors, None
     if scene.reduction.rule == "auto" and scene.model.bit_rock:
         stuck = stuck_bit_modes(disc, reduction_bands(scene)["torsional"], operators.mass, operators.stiffness)
-        vectors = augment(vectors, stuck.vectors, operators.mass)
+        vectors = augment(vectors, stuck.vectors, operators.mass, MODE_SPAN_TOLERANCE)
     drive = [disc.end_dof(U, 0), disc.end_dof(THETA_X, 0)]
     phi, guard = enrich(vectors, scene, disc, operators, lambda phi: phi[drive])
     tolerance = scene.reduction.guard_tolerance
