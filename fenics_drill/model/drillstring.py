@@ -203,8 +203,8 @@ class DrillstringModel:
         """Residual at (q, qd, qdd, mu); with (c_u, c_v, c_a) also the tangent.
 
         ``internal_parts`` (df/dq, df/dqd, df/dqdd) of the internal force may come from an
-        earlier state (modified Newton); without them they are computed at this state, only
-        those with a non-zero coefficient.
+        earlier state (modified Newton); without them, and for each part given as None, they are
+        computed at this state, only those with a non-zero coefficient.
         The point forces' tangents are always fresh.
         """
         internal = self.internal.evaluate(q, qd, qdd)
@@ -222,8 +222,10 @@ class DrillstringModel:
             residual += self.constraints.T @ mu
         out = Evaluation(residual, internal, external, evaluations, drive)
         if want:
-            needed = tuple(c != 0 for c in tangent_coefficients)
-            parts = internal_parts if internal_parts is not None else self.internal.tangent_parts(needed)
+            kept = internal_parts if internal_parts is not None else (None, None, None)
+            needed = tuple(c != 0 and part is None for c, part in zip(tangent_coefficients, kept))
+            fresh = self.internal.tangent_parts(needed) if any(needed) else kept
+            parts = tuple(part if part is not None else new for part, new in zip(kept, fresh))
             out.internal_parts = parts if all(p is not None for p in parts) else None  # reusable only if whole
             out.tangent_of = lambda: self._tangent(tangent_coefficients, parts, evaluations, drive)
         return out

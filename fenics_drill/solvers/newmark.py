@@ -22,8 +22,15 @@ from fenics_drill.solvers.newton import saddle_newton
 #: per update (the stiff bit and wall laws make it rarely so in their transients: then it is fresh).
 TANGENT_REUSE_RATE = 0.1
 #: A Newton update that shrinks the residual less than this (where a consistent tangent gives quadratic
-#: convergence) has the internal tangent of earlier steps assembled afresh for the next one.
+#: convergence) has the stiffness part df/dq of the internal tangent of earlier steps assembled afresh for the
+#: next one.  It is the part that drifts between the periodic refreshes: the spin turns the stiffness of a
+#: deflected string, and the printed kinematics' strains turn with theta_x itself; df/dqd and df/dqdd are kept
+#: up to ``tangent_reuse`` steps (measured: the same Newton iterations as a refresh of all three, at a third
+#: of the assembly; benchmarks/RESULTS.md, issue 17, item 52).
 SLOW_CONTRACTION = 0.25
+
+#: Which parts (df/dq, df/dqd, df/dqdd) of the internal tangent an evaluation assembles afresh.
+ALL_PARTS, STIFFNESS_PART, NO_PART = (True, True, True), (True, False, False), (False, False, False)
 
 
 class NewtonFailure(RuntimeError):
@@ -63,7 +70,8 @@ class NewmarkNewton:
         self.gamma, self.beta = newmark_parameters(alpha)
         self.tolerance, self.max_iterations = tolerance, max_iterations
         self._internal_parts = None
-        self._steps_since_tangent = 0
+        # accepted steps since all parts of the internal tangent, and since its df/dq, were assembled
+        self._steps_since_tangent = self._steps_since_stiffness = 0
         self._force_level = 0.0
 
     def forget_tangent(self) -> None:
@@ -86,7 +94,7 @@ class NewmarkNewton:
         zero = np.zeros_like(q)
         held = np.zeros(self.model.constraints.shape[0])
         ev = self.model.evaluate(q, qd, zero, held, tangent_coefficients=(0.0, 0.0, 1.0))
-        self._internal_parts, self._steps_since_tangent = ev.internal_parts, 0
+        self._internal_parts, self._steps_since_tangent, self._steps_since_stiffness = ev.internal_parts, 0, 0
         qdd, mu = self.model.space.saddle_solve(ev.tangent, self.model.constraints, -ev.residual, held)
         return qdd, mu
 
@@ -109,12 +117,19 @@ class NewmarkNewton:
             qdd = (q - q_pred) * c_a
             return qd_pred + g * dt * qdd, qdd
 
-        def evaluate(q, mu, refresh=False):
+        def evaluate(q, mu, fresh=NO_PART):
+            """The evaluation at q, with the ``fresh`` parts of the internal tangent assembled at it (all of
+            them when none are kept) and the others kept from earlier steps."""
             qd, qdd = rates(q)
-            ev = self.model.evaluate(q, qd, qdd, mu, coefficients,
-                                     internal_parts=None if refresh else self._internal_parts)
-            if refresh:
-                self._internal_parts, self._steps_since_tangent = ev.internal_parts, 0
+            if self._internal_parts is None:
+                fresh = ALL_PARTS
+            kept = None if fresh == ALL_PARTS else tuple(None if new else part
+                                                         for new, part in zip(fresh, self._internal_parts))
+            ev = self.model.evaluate(q, qd, qdd, mu, coefficients, internal_parts=kept)
+            if any(fresh):
+                self._internal_parts, self._steps_since_stiffness = ev.internal_parts, 0
+                if fresh == ALL_PARTS:
+                    self._steps_since_tangent = 0
             return ev
 
         def check(iteration, q, mu, ev, norm, gap):
@@ -134,22 +149,23 @@ class NewmarkNewton:
             if all(abs(g) <= self.tolerance * max(abs(t), 1.0) for g, t in zip(gap.tolist(), target.tolist())):
                 self._force_level = max(self._force_level, scale)
                 self._steps_since_tangent += 1
+                self._steps_since_stiffness += 1
                 return State(state.t + dt, q, *rates(q), mu), iteration, ev
             return None
 
         q = state.q + dt * state.qd + 0.5 * dt * dt * state.qdd
         mu = state.mu.copy()
         stale = self._internal_parts is None or self._steps_since_tangent >= self.tangent_reuse
-        ev = evaluate(q, mu, stale and self.model.internal.state_dependent)
+        ev = evaluate(q, mu, ALL_PARTS if stale and self.model.internal.state_dependent else NO_PART)
         norms = []  # the residual norm of every iterate of this step, as check sees them
 
         def trial(q, mu):
             """An iterate's evaluation.  Newton that contracts slowly although its tangent is fresh has an
-            internal tangent of earlier steps that drifted (the large deflections of a full-order string):
-            the next evaluation assembles it afresh, once per step."""
+            internal stiffness df/dq of earlier steps that drifted (the large deflections of a full-order
+            string, the spin): the next evaluation assembles it afresh, once per step."""
             slow = len(norms) >= 2 and norms[-1] > SLOW_CONTRACTION * norms[-2]
-            stale = self._steps_since_tangent > 0 and self.model.internal.state_dependent
-            return evaluate(q, mu, refresh=slow and stale)
+            drifted = self._steps_since_stiffness > 0 and self.model.internal.state_dependent
+            return evaluate(q, mu, STIFFNESS_PART if slow and drifted else NO_PART)
 
         result = saddle_newton(trial, self.model.space, self.model.constraints, target,
                                q, mu, ev, check, self.max_iterations, reuse_rate=TANGENT_REUSE_RATE,

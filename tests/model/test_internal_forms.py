@@ -63,3 +63,26 @@ def test_a_tangent_part_exists_exactly_where_the_nonlinear_remainder_depends_on_
             assert not nonlinear.any()
             moved = [x + rng.standard_normal(model.size) if i == k else x for i, x in enumerate(state)]
             assert np.array_equal(force.element_vectors(*moved), before)
+
+
+
+def test_an_evaluation_assembles_only_the_internal_tangent_parts_it_is_not_given():
+    """Newton's slow-contraction refresh assembles df/dq afresh and keeps df/dqd, df/dqdd of earlier steps
+    (solvers/newmark.py): the tangent must then be c_u df/dq at this state plus c_v, c_a times the parts
+    given, i.e. the fresh tangent less c_v (C_fresh - C_given) and c_a (M_fresh - M_given).  The parts given
+    here are random matrices of the parts' size, so that using a fresh part where one is given (or the
+    reverse) changes the tangent at order one.  Reference: the evaluation with every part fresh; the same
+    matrices summed in another order (1e-12 of the largest entry)."""
+    model = build_model(scene_with("beam.length=10.0", "beam.elements=20", "model.contact=false"))
+    rng = np.random.default_rng(3)
+    state = [size * rng.standard_normal(model.size) for size in (0.3, 10.0, 100.0)]
+    mu = np.zeros(model.constraints.shape[0])
+    coefficients = (1.0, 2e3, 4e6)
+    fresh = model.evaluate(*state, mu, coefficients)
+    stiffness, damping, mass = fresh.internal_parts
+    given = tuple(np.abs(part).max() * rng.standard_normal(part.shape) for part in (damping, mass))
+    partial = model.evaluate(*state, mu, coefficients, internal_parts=(None, *given))
+    assert partial.internal_parts[1] is given[0] and partial.internal_parts[2] is given[1]
+    assert np.allclose(partial.internal_parts[0], stiffness, rtol=0, atol=1e-12 * np.abs(stiffness).max())
+    expected = fresh.tangent - coefficients[1] * (damping - given[0]) - coefficients[2] * (mass - given[1])
+    assert np.allclose(partial.tangent, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
