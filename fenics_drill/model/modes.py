@@ -168,7 +168,8 @@ SPIN_HARMONICS = 5.0
 
 def step_band(scene) -> float:
     """The f* up to which the scene's time step resolves the motion: f*_max of the band B with the
-    nominal step 1 / (2 f_max) of Section 6.2, or L / (2 dt c_L) with a step of the scene's own."""
+    nominal step (time.band_steps steps per period of f_max, at least 2), or the Nyquist band L / (2 dt c_L)
+    of a step of the scene's own."""
     p = scene.beam_properties
     f_star_max = scene.modal.f_star_max
     if scene.time.dt > 0:
