@@ -162,11 +162,12 @@ class Time:
     dt: float = key(-1.0, "nominal time step [s]; -1: 1/(time.band_steps f_max) with f_max = f*_max c_L / L",
                     lambda x: x == -1.0 or x > 0, "> 0 (or -1 for the nominal step of time.band_steps)")
     band_steps: float = key(8.0, "steps per period of the band's highest frequency f_max in the nominal step "
-                            "(time.dt = -1) [-]; 8 keeps the efficiency (96) within 1 % of the converged full "
-                            "order (0.4 % on the paper scene over 10 s, 0.3-0.6 % on 30-50 m strings); 2 is the "
-                            "paper's step 1/(2 f_max) of Section 6.2, which leaves it 4-6 % high: the drive "
-                            "torque's oscillation, which (98) counts only while it drives, is not resolved "
-                            "(docs/verification.md)", lambda x: x >= 2.0, ">= 2 (Nyquist)")
+                            "(time.dt = -1) [-]; 2 is the paper's step 1/(2 f_max) of Section 6.2, which leaves "
+                            "the efficiency (96) 4-7 % high against the step-converged full order: the drive "
+                            "torque's oscillation, which (98) counts only while it drives, is not resolved. "
+                            "8 leaves 0.3-0.6 % on 30-50 m strings and 2.4 % on the paper scene over 10 s, "
+                            "whose efficiency converges at first order (time.dt = 3e-4: 1.5 %; "
+                            "docs/verification.md)", lambda x: x >= 2.0, ">= 2 (Nyquist)")
     newmark_alpha: float = key(0.015, "alpha of Newmark's gamma = 1/2 + alpha, beta = (1/2 + gamma)^2 / 4 "
                                "(Section 4.3) [-]", lambda x: 0 <= x <= 0.5, "in [0, 0.5]")
     adaptive: bool = key(True, "refine the step where the local error estimate exceeds time.error_tolerance")
