@@ -113,7 +113,9 @@ def main() -> None:
              f"Command: `python benchmarks/speed_table.py --before {args.before}`. Accuracy: relative difference "
              "of rop / efficiency from the full order (500 elements, nominal step, same horizon). The Monte Carlo "
              "row's steps are those of its nominal and 4 sampled realisations, its accuracy the nominal "
-             "realisation's (a realisation does not count its Newton iterations).", "",
+             "realisation's (a realisation does not count its Newton iterations). Each tree runs its own defaults: "
+             "the nominal step of the code before is the paper's 1/(2 f_max), today's is 1/(8 f_max) (time.band_steps, "
+             "docs/verification.md), and the full order is run at today's.", "",
              "| row | code | wall [s] | steps | Newton iterations | rop / efficiency vs full order | "
              "costliest functions (own time) |", "|---|---|---|---|---|---|---|"]
     for row, (kind, overrides, ref_name) in ROWS.items():
