@@ -31,7 +31,8 @@ demo-as-printed: setup
 	$(PY) -m fenics_drill.cli plot $(OUT)/as-printed
 
 ## Section 6 as printed and consistent, side by side (docs/reproduction.md): the nominal runs, the three
-## windows and a Monte Carlo of each model on RANKS processes (about 50 min on 2 ranks); resumes where it stopped.
+## windows and a Monte Carlo of each model on RANKS processes (about 50 min on 2 ranks, measured at the paper's
+## step; the consistent model now runs at the finer default step, 2.2x the nominal scene's cost); resumes where it stopped.
 reproduction: setup
 	$(PY) benchmarks/reproduction.py --ranks $(RANKS)
 
@@ -39,7 +40,7 @@ reproduction: setup
 test: setup
 	$(PY) -m pytest -q tests
 
-## Speed before and after issue 17 (benchmarks/speed.md, about 25 min), the reduced models against the
+## Speed before and after issue 17 (benchmarks/speed.md, 8 min in the tenth sitting), the reduced models against the
 ## full order (benchmarks/reduced_accuracy.md, issue 14), then the older studies.
 bench: setup
 	$(PY) benchmarks/speed_table.py --before 50d35ac
