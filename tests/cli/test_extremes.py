@@ -111,3 +111,15 @@ def test_a_scene_that_never_touches_the_wall_is_told_contact_is_not_needed(tmp_p
     on_wall = tmp_path / "wall"
     assert main(["run", *BASE, *[i for o in ON_WALL for i in ("--set", o)], "--quiet", "--out", str(on_wall)]) == 0
     assert "advice" not in json.loads((on_wall / "summary.json").read_text())
+
+
+def test_a_run_at_a_step_too_coarse_for_the_efficiency_is_told_so(tmp_path):
+    """The paper's nominal step 1/(2 f_max) leaves the efficiency 4-7 % high (docs/verification.md): a run at it
+    says so; the default step (8 per period of f_max) and a finer explicit one do not."""
+    said = {}
+    for name, step in (("paper", ["time.band_steps=2"]), ("default", []), ("finer", [f"time.dt={NOMINAL_DT_10M / 8}"])):
+        out = tmp_path / name
+        assert main(["run", *BASE, *[i for o in step for i in ("--set", o)], "--quiet", "--out", str(out)]) == 0
+        said[name] = " ".join(json.loads((out / "summary.json").read_text()).get("advice", []))
+    assert "2 steps per period" in said["paper"] and "efficiency" in said["paper"]
+    assert "steps per period" not in said["default"] + said["finer"]
