@@ -27,14 +27,23 @@ class StepTooSmall(RuntimeError):
     """The step would have to go below dt_nominal / 2^max_step_cuts."""
 
 
+def band_frequency(scene) -> float:
+    """f_max = f*_max c_L / L, the highest frequency of the band B [Hz]."""
+    p = scene.beam_properties
+    return scene.modal.f_star_max * p.longitudinal_wave_speed / p.length
+
+
 def nominal_step(scene) -> float:
-    """time.dt, or 1 / (n f_max) with f_max = f*_max c_L / L and n = time.band_steps steps per period of
-    f_max (n = 2: the paper's step of Section 6.2)."""
+    """time.dt, or 1 / (n f_max) with n = time.band_steps steps per period of f_max (n = 2: the paper's step
+    of Section 6.2)."""
     if scene.time.dt > 0:
         return scene.time.dt
-    p = scene.beam_properties
-    f_max = scene.modal.f_star_max * p.longitudinal_wave_speed / p.length
-    return 1.0 / (scene.time.band_steps * f_max)
+    return 1.0 / (scene.time.band_steps * band_frequency(scene))
+
+
+def steps_per_band_period(scene) -> float:
+    """How many nominal steps a period of f_max holds (time.band_steps, or what an explicit time.dt gives)."""
+    return 1.0 / (nominal_step(scene) * band_frequency(scene))
 
 
 class StepController:

@@ -25,16 +25,18 @@ from fenics_drill.model.modes import drive_held_modes
 from fenics_drill.model.resources import check_memory
 from fenics_drill.observables.drilling_quantities import drilling_quantities
 from fenics_drill.observables.step_rows import StepRows
+from fenics_drill.scene import Time
 from fenics_drill.solvers.static import StaticFailure, static_report
-from fenics_drill.solvers.step_control import StepTooSmall, nominal_step
+from fenics_drill.solvers.step_control import StepTooSmall, nominal_step, steps_per_band_period
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
 from fenics_drill.studies.lifecycle import StopOnSignal, command_output
 from fenics_drill.studies.prepare import prepare
 
 
-#: A nominal step that resolves the band's highest frequency f_max with fewer steps per period than this is
-#: told that its efficiency (96) is not resolved: 4-7 % high at the paper's 2 (docs/verification.md).
-RESOLVING_BAND_STEPS = 8.0
+#: A nominal step that resolves the band's highest frequency f_max with fewer steps per period than the
+#: default time.band_steps is told that its efficiency (96) is not resolved: 4-7 % high at the paper's 2
+#: (docs/verification.md).
+RESOLVING_BAND_STEPS = Time.band_steps
 
 #: A run whose string went deeper into the wall than this share of the gap is reported "suspect": the
 #: Hunt-Crossley law (17) models a stiff wall, so a deep penetration means the time step or the contact
@@ -255,8 +257,7 @@ def quantities_of_run(series_path: Path) -> dict:
         out["max_von_mises"] = {"value": float(stress[k]), "x": float(data["max_von_mises_x"][k]),
                                 "t": float(data["time"][k])}
     advice = []
-    p = scene.beam_properties
-    band_steps = p.length / (scene.modal.f_star_max * p.longitudinal_wave_speed * nominal_step(scene))
+    band_steps = steps_per_band_period(scene)
     if band_steps < RESOLVING_BAND_STEPS * (1.0 - 1e-9):
         advice.append(f"the nominal step resolves the band's f_max with {band_steps:.3g} steps per period (the "
                       f"default {RESOLVING_BAND_STEPS:g}): the efficiency (96) may come out several % high (4-7 % "

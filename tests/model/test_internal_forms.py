@@ -83,6 +83,10 @@ def test_an_evaluation_assembles_only_the_internal_tangent_parts_it_is_not_given
     given = tuple(np.abs(part).max() * rng.standard_normal(part.shape) for part in (damping, mass))
     partial = model.evaluate(*state, mu, coefficients, internal_parts=(None, *given))
     assert partial.internal_parts[1] is given[0] and partial.internal_parts[2] is given[1]
+    # the same kernels at the same state: df/dq agrees to the round-off of its assembly (entries ~1e14 summed
+    # from 20 cells: ~1e-15 relative), so 1e-12 of the largest entry; a stale or wrong part errs at order one
     assert np.allclose(partial.internal_parts[0], stiffness, rtol=0, atol=1e-12 * np.abs(stiffness).max())
     expected = fresh.tangent - coefficients[1] * (damping - given[0]) - coefficients[2] * (mass - given[1])
+    # the same six matrices combined in another order (a few roundings of the largest term, ~1e-15 of it), so
+    # 1e-12; using a fresh part where one is given changes entries at the size of the random given ones
     assert np.allclose(partial.tangent, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
