@@ -30,7 +30,7 @@ from fenics_drill.model.hyper_reduction import RETRAIN_ABOVE, sampling_error, tr
 from fenics_drill.model.internal_force import ElementSample, internal_force
 from fenics_drill.model.operators import LinearOperators, assemble_linear
 from fenics_drill.model.enrichment import augment
-from fenics_drill.model.spaces import FullSpace, ModalSpace, solution_space
+from fenics_drill.model.spaces import FullSpace, ModalSpace, solution_space, stack_rows
 from fenics_drill.model.top_drive import DriveLoads, TopDrive
 
 
@@ -74,6 +74,10 @@ class DrillstringModel:
         # where the step's local error is measured [m]: the lateral displacements (impacts) and, at the
         # bit, the axial displacement and the arc r theta_x of the surface (the bit-rock law's stiff laws)
         self.error_rows = (*self.lateral_rows, self.bit_rows[0:1], disc.properties.outer_radius * self.bit_rows[1:2])
+        # every vertex's displacements (u, v, w) and surface arc r theta_x [m]: how far an increment of q moves
+        # any point of the string's surface (Newton's stopping test, solvers/newmark.py)
+        self.motion_rows = stack_rows([*(space.rows(disc.vertex_dofs(f)) for f in (U, V, W)),
+                                       disc.properties.outer_radius * space.rows(disc.vertex_dofs(THETA_X))])
         self.operators = operators
         self.exact_internal, self.hyper_reduction, self.training_states = None, None, []  # set by with_sample
 

@@ -114,6 +114,20 @@ def constraint_scale(tangent, constraints) -> float:
     return diagonal / largest if diagonal > 0 and largest > 0 else 1.0
 
 
+def stack_rows(rows) -> np.ndarray | sp.csr_matrix:
+    """Rows of [Phi] (of either space) stacked into one map, so that one product gives them all: CSR for the
+    full space, contiguous dense for a modal one."""
+    if any(map(sp.issparse, rows)):
+        return sp.vstack(rows, format="csr")
+    return np.ascontiguousarray(np.vstack(rows))
+
+
+def column_bound(rows) -> np.ndarray:
+    """The largest |entry| of each column of ``rows``: max_i |(rows x)_i| <= sum_j of it |x_j| for any x."""
+    bound = abs(rows).max(axis=0)
+    return bound.toarray().ravel() if sp.issparse(bound) else np.asarray(bound).ravel()
+
+
 class ModalSpace:
     """Dense modal basis [Phi] (N_dofs x N_red)."""
 

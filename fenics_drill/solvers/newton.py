@@ -44,7 +44,7 @@ def backtrack(trial, norm0: float, step: float = 1.0, kink=None):
 def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np.ndarray, q: np.ndarray,
                   mu: np.ndarray, evaluation, check: Callable, max_iterations: int,
                   first_step: Callable[[np.ndarray], float] | None = None, reuse_rate: float = 0.0,
-                  kink_step: Callable | None = None):
+                  kink_step: Callable | None = None, settled: Callable | None = None):
     """Iterate from (q, mu), whose ``evaluation`` (with ``.residual`` and ``.tangent``) is given.
 
     ``evaluate(q, mu)`` evaluates a trial state.  Before each update
@@ -57,7 +57,9 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
     2004, Sec. 2.1); a slower or damped update takes a fresh one.
     ``kink_step(evaluation, dq)`` gives the fraction of an update just past the first kink of a force
     law along it (None if there is none before the full update): the line search's second trial.
-    Returns None when ``max_iterations`` updates did not satisfy ``check``.
+    ``settled(iteration, q, mu, evaluation, dq, dmu, gap)`` may stop with a verdict once the next update
+    (dq, dmu) is known to be negligible, before it is taken (an iterate need not be evaluated again to
+    learn that it is converged).  Returns None when ``max_iterations`` updates did not satisfy ``check``.
     """
     norm = math.sqrt(evaluation.residual @ evaluation.residual)
     tangent = None
@@ -69,6 +71,10 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
         if tangent is None:
             tangent = evaluation.tangent
         dq, dmu = space.saddle_solve(tangent, constraints, -evaluation.residual, -gap)
+        if settled is not None:
+            verdict = settled(iteration, q, mu, evaluation, dq, dmu, gap)
+            if verdict is not None:
+                return verdict
 
         def trial(step):
             point = (q + dq, mu + dmu) if step == 1.0 else (q + step * dq, mu + step * dmu)

@@ -20,7 +20,8 @@ failure halves the step; after ``time.max_step_cuts`` halvings the run stops.
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
+
+from fenics_drill.model.spaces import column_bound, stack_rows
 
 
 class StepTooSmall(RuntimeError):
@@ -58,11 +59,9 @@ class StepController:
         self.tolerance = scene.time.error_tolerance
         self.error_factor = abs(beta - 1.0 / 6.0)
         # the maps of q to the displacements [m] the error is measured on, stacked (one product per step)
-        self.error_rows = sp.vstack(error_rows, format="csr") if any(map(sp.issparse, error_rows)) \
-            else np.ascontiguousarray(np.vstack(error_rows))
-        # the largest |entry| of each column: max_i |(R e)_i| <= sum_j of it |e_j|, in N_red products
-        column_bound = abs(self.error_rows).max(axis=0)
-        self.column_bound = column_bound.toarray().ravel() if sp.issparse(column_bound) else column_bound
+        self.error_rows = stack_rows(error_rows)
+        # max_i |(R e)_i| <= sum_j of it |e_j|, in N_red products
+        self.column_bound = column_bound(self.error_rows)
         self.dt = self.nominal
         self.forced_steps = 0  # steps accepted at the minimum size although their error exceeded the tolerance
         self.worst_forced_ratio = 0.0

@@ -45,7 +45,7 @@ class Simulation:
         self.model, self.scene = model, scene
         solver = scene.solver
         self.stepper = NewmarkNewton(model, scene.time.newmark_alpha, solver.newton_tolerance,
-                                     solver.newton_max_iterations, solver.tangent_reuse)
+                                     solver.newton_max_iterations, solver.tangent_reuse, scene.time.error_tolerance)
         self.controller = StepController(scene, self.stepper.beta, model.error_rows)
         n_vertices = len(model.disc.vertex_x)
         self.impacts_per_vertex = np.zeros(n_vertices, dtype=np.int64)

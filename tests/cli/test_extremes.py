@@ -106,8 +106,11 @@ def test_a_scene_that_never_touches_the_wall_is_told_contact_is_not_needed(tmp_p
         results[contact] = json.loads((out / "summary.json").read_text())
     assert "model.contact = false" in results["true"]["advice"][0]
     assert "advice" not in results["false"]
+    # the same answer up to round-off and where Newton stops: it takes an iterate once its next update moves
+    # the string by less than 1e-9 m (solvers/newmark.py, SETTLED_SHARE), and round-off can move that decision
+    # by an iteration (measured: 3e-12; 5e-13 with Newton driven to its residual tolerance)
     for key in ("rop", "efficiency", "mean_bit_velocity"):
-        assert results["false"][key] == pytest.approx(results["true"][key], rel=1e-12), key
+        assert results["false"][key] == pytest.approx(results["true"][key], rel=1e-9), key
     on_wall = tmp_path / "wall"
     assert main(["run", *BASE, *[i for o in ON_WALL for i in ("--set", o)], "--quiet", "--out", str(on_wall)]) == 0
     assert "advice" not in json.loads((on_wall / "summary.json").read_text())
