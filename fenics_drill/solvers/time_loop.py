@@ -82,7 +82,7 @@ class Simulation:
     def _penetration(ev: Evaluation) -> float:
         """Deepest indentation of the string into the wall at an evaluated state [m] (0 without contact)."""
         wall = ev.forces.get("wall")
-        return float(wall.indentation.max(initial=0.0)) if wall is not None else 0.0
+        return float(wall.delta.max(initial=0.0)) if wall is not None else 0.0
 
     def _contact(self, ev: Evaluation, previous: np.ndarray) -> np.ndarray:
         """Vertices in contact with the wall at an evaluated state (``previous`` when contact is off)."""

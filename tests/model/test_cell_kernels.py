@@ -9,7 +9,7 @@ from dolfinx import fem
 
 from fenics_drill.model.cell_kernels import CellAssembly
 from fenics_drill.model.discretization import BeamDiscretization
-from fenics_drill.model.forces.wall_contact import _contact_blocks, _modal_pass, _vertex_loads
+from fenics_drill.model.forces.wall_contact import _contact_blocks, _modal_pass, _projected_laws, _vertex_loads
 from fenics_drill.model.internal_force import ElementSample, InternalForms, SampledCoefficients
 from fenics_drill.solvers.static import solve_static
 from fenics_drill.studies.prepare import prepare
@@ -132,7 +132,7 @@ def test_cell_assembly_refuses_a_bilinear_form_of_two_spaces(sampled_forms):
 def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
     """In the default (modal) space, at 20 random states around the string's rest on the wall, the one-pass
     kernel gives (1) the positions and rates [Phi] q, [Phi] qd, (2) the pointwise law (16)-(19) at them and
-    (3) [Phi]^T of its loads, and of each law's loads.  It sums in another order than BLAS (reassociated,
+    (3) [Phi]^T of its loads, and (:func:`_projected_laws`) of each law's loads.  They sum in another order than BLAS (reassociated,
     vectorised) and may fuse multiply-adds, so each part is held to the round-off that allows, nothing looser:
 
     * a sum of n products in any order differs by at most n eps sum|terms| (Higham, Accuracy and Stability,
@@ -152,8 +152,8 @@ def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
     for _ in range(20):
         q = resting * (1 + 0.05 * rng.standard_normal(model.size))
         qd = rng.standard_normal(model.size) * 0.5
-        delta, nodal, laws, potential, generalised, lateral, rates, projected = _modal_pass(flat, q, qd,
-                                                                                            *wall._law())
+        delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(flat, q, qd, *wall._law())
+        projected = _projected_laws(flat, delta, laws)
         # (1) positions and rates
         position_bound = terms * eps * (np.abs(lateral_rows) @ np.abs(q)).reshape(-1, 2)
         rate_bound = terms * eps * (np.abs(flat) @ np.abs(qd)).reshape(-1, 4)

@@ -144,13 +144,13 @@ def _vertex_loads(lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_to
 def _modal_pass(flat, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s):
     """:func:`_vertex_loads` in a modal space, in one pass over the dense rows ``flat`` of [Phi]
     ((u, v, w, theta_x) of each vertex, interleaved): each vertex's positions and rates, its law, and
-    [Phi]^T of its nodal loads, while its four rows are in cache; [Phi]^T of the loads of each law
-    (damper, axial friction, friction torque: rows of ``projected``) come with them.  Also returns the
-    positions and rates."""
+    [Phi]^T of its nodal loads, while its four rows are in cache.  Also returns the positions and rates.
+    The split by law is left to :func:`_projected_laws` (the budget reads it at accepted steps only: in the
+    pass it cost a sixth of the pass at every Newton iterate)."""
     n, size = flat.shape[0] // 4, flat.shape[1]
     delta, nodal, laws = np.empty(n), np.zeros((n, 4)), np.zeros((n, 4, 3))
-    lateral, rates, projected = np.empty((n, 2)), np.empty((n, 4)), np.zeros((3, size))
-    lateral_loads = np.zeros(size)
+    lateral, rates = np.empty((n, 2)), np.empty((n, 4))
+    generalised = np.zeros(size)
     potential = 0.0
     for i in range(n):
         base = 4 * i
@@ -168,14 +168,27 @@ def _modal_pass(flat, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque,
                                  v_s, delta, nodal, laws)
         if delta[i] > 0.0:
             axial, load_v, load_w, torque = nodal[i, 0], nodal[i, 1], nodal[i, 2], nodal[i, 3]
-            damper_v, damper_w = laws[i, 1, 0], laws[i, 2, 0]
             for j in range(size):
-                lateral_loads[j] += flat[base + 1, j] * load_v + flat[base + 2, j] * load_w
+                generalised[j] += (flat[base, j] * axial + flat[base + 1, j] * load_v + flat[base + 2, j] * load_w
+                                   + flat[base + 3, j] * torque)
+    return delta, nodal, laws, potential, generalised, lateral, rates
+
+
+@kernel(fastmath=REASSOCIATE)
+def _projected_laws(flat, delta, laws):
+    """[Phi]^T of the loads of the damper, the axial friction and the friction torque (rows of the result),
+    over the vertices in contact (delta > 0) of the dense rows ``flat`` of :func:`_modal_pass`."""
+    size = flat.shape[1]
+    projected = np.zeros((3, size))
+    for i in range(delta.size):
+        if delta[i] > 0.0:
+            base = 4 * i
+            damper_v, damper_w, axial, torque = laws[i, 1, 0], laws[i, 2, 0], laws[i, 0, 1], laws[i, 3, 2]
+            for j in range(size):
                 projected[0, j] += flat[base + 1, j] * damper_v + flat[base + 2, j] * damper_w
                 projected[1, j] += flat[base, j] * axial
                 projected[2, j] += flat[base + 3, j] * torque
-    generalised = lateral_loads + projected[1] + projected[2]
-    return delta, nodal, laws, potential, generalised, lateral, rates, projected
+    return projected
 
 
 @kernel
@@ -290,19 +303,23 @@ def _selection(rows: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
 
 
 class ProjectedLaws(Mapping):
-    """The generalised forces of the non-conservative wall laws (the damper of (17), (18), (19)) in the full
-    space, projected on first use: the energy budget reads them at accepted steps only, not at Newton's
-    iterates (a modal space's pass projects them with the nodal loads, while the rows are in cache)."""
+    """The generalised forces of the non-conservative wall laws (the damper of (17), (18), (19)), projected on
+    first use: the energy budget reads them at accepted steps only, not at Newton's iterates."""
 
     NAMES = ("wall_damper", "wall_axial_friction", "wall_friction_torque")
 
-    def __init__(self, flat, loads: np.ndarray):
-        self._flat, self._loads, self._projected = flat, loads, None
+    def __init__(self, flat, delta: np.ndarray, loads: np.ndarray):
+        """``flat``: the rows of (u, v, w, theta_x) of the vertices evaluated, interleaved; ``delta``, ``loads``:
+        their indentations and the loads of each law (vertex, field, law)."""
+        self._flat, self._delta, self._loads, self._projected = flat, delta, loads, None
 
     def _laws(self) -> dict[str, np.ndarray]:
         if self._projected is None:
-            projected = np.asarray(self._flat.T @ self._loads.reshape(-1, len(self.NAMES)))
-            self._projected = {name: projected[:, k] for k, name in enumerate(self.NAMES)}
+            if sp.issparse(self._flat):
+                projected = np.asarray(self._flat.T @ self._loads.reshape(-1, len(self.NAMES))).T
+            else:
+                projected = _projected_laws(self._flat, self._delta, self._loads)
+            self._projected = dict(zip(self.NAMES, projected))
         return self._projected
 
     def __getitem__(self, name: str) -> np.ndarray:
@@ -482,11 +499,10 @@ class WallContact:
             rates = (vertex_set.flat @ qd).reshape(-1, len(FIELDS))
             delta, nodal, laws, potential = _vertex_loads(lateral, rates, *self._law())
             generalised = np.asarray(vertex_set.flat.T @ nodal.ravel())
-            by_law = ProjectedLaws(vertex_set.flat, laws)
         else:
-            delta, nodal, _, potential, generalised, lateral, rates, projected = _modal_pass(vertex_set.flat, q, qd,
-                                                                                             *self._law())
-            by_law = dict(zip(ProjectedLaws.NAMES, projected))
+            delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(vertex_set.flat, q, qd,
+                                                                                     *self._law())
+        by_law = ProjectedLaws(vertex_set.flat, delta, laws)
         out = WallForces(generalised, potential, by_law, len(self.x), vertex_set.vertices, delta, nodal)
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
             out.tangent_data = (vertex_set.flat, lateral, rates)
