@@ -159,13 +159,14 @@ class NewmarkNewton:
             return ev
 
         def check(iteration, q, mu, ev, norm, gap):
-            norms.append(norm)
             if not math.isfinite(norm):
                 raise NewtonFailure(f"Newton produced non-finite values at dt = {dt:.3e} s")
             # the residual is measured against the forces that balance at this iterate and at the states
             # accepted before (never against a predictor's residual: an explosive predictor would make
             # any iterate look converged)
             scale = self._scale(ev, self.model.constraints.T @ mu, self.model.mass @ ((q - q_pred) * c_a))
+            norms.append(norm)
+            scales.append(scale)
             if norm > self.tolerance * max(self._force_level, scale):
                 # the inertia M (q - q_pred) / (beta dt^2) cannot be known better than round-off in q: a
                 # string that only spins, unloaded, has nothing else to measure its residual against
@@ -188,21 +189,21 @@ class NewmarkNewton:
             """The iterate as the step's result, when the next update (dq, dmu) is negligible against what the
             step's error and the efficiency may be (SETTLED_SHARE, SETTLED_FORCE_SHARE): the iterate whose
             residual is still above the tolerance need not be moved and evaluated once more.  Measured: a
-            fifth of the evaluations saved, the efficiency unchanged to 1e-5 (benchmarks/RESULTS.md, item 53)."""
+            quarter of the paper scene's evaluations saved, its efficiency unchanged to 1e-5 (benchmarks/RESULTS.md,
+            item 53)."""
             if self.settle_length is None or len(norms) < 2 or norms[-1] > SETTLED_CONTRACTION * norms[-2]:
                 return None
             if not self._moves_less_than(dq, SETTLED_SHARE * self.settle_length):
                 return None
             if np.any(np.abs(dmu) > SETTLED_FORCE_SHARE * self._multiplier_level):
                 return None
-            scale = self._scale(ev, self.model.constraints.T @ mu, self.model.mass @ ((q - q_pred) * c_a))
-            return accepted(iteration, q, mu, ev, gap, scale)
+            return accepted(iteration, q, mu, ev, gap, scales[-1])  # the scale check measured this iterate by
 
         q = state.q + dt * state.qd + 0.5 * dt * dt * state.qdd
         mu = state.mu.copy()
         stale = self._internal_parts is None or self._steps_since_tangent >= self.tangent_reuse
         ev = evaluate(q, mu, ALL_PARTS if stale and self.model.internal.state_dependent else NO_PART)
-        norms = []  # the residual norm of every iterate of this step, as check sees them
+        norms, scales = [], []  # the residual norm and force scale of every iterate of this step, as check sees them
 
         def trial(q, mu):
             """An iterate's evaluation.  Newton that contracts slowly although its tangent is fresh has an
