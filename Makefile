@@ -40,7 +40,7 @@ reproduction: setup
 test: setup
 	$(PY) -m pytest -q tests
 
-## Speed before and after issue 17 (benchmarks/speed.md, 8 min in the tenth sitting), the reduced models against the
+## Speed before and after issue 17 (benchmarks/speed.md, 5 min in the eleventh sitting), the reduced models against the
 ## full order (benchmarks/reduced_accuracy.md, issue 14), then the older studies.
 bench: setup
 	$(PY) benchmarks/speed_table.py --before 50d35ac
@@ -64,7 +64,8 @@ campbell: setup
 	$(PY) -m fenics_drill.cli campbell demos/scenes/campbell_paper.toml --set campbell.weight_on_bit=true \
 		--overwrite --out $(OUT)/campbell-wob
 
-## The paper's Monte Carlo study (Section 6.11) at SAMPLES realisations on RANKS processes.
+## The paper's Monte Carlo study (Section 6.11) at SAMPLES realisations on RANKS processes (about 14 s per
+## realisation of 10 s on each of 2 ranks here: the paper's 1024 in about 2.0 h).
 SAMPLES ?= 32
 RANKS ?= 2
 mc: setup
