@@ -32,8 +32,8 @@ SLOW_CONTRACTION = 0.25
 #: An iterate is the step's result, without another evaluation, when Newton's next update would move no point
 #: of the string's surface by more than this share of time.error_tolerance (the role of kappa in Hairer &
 #: Wanner's stopping test, Sec. IV.8, there 0.01-0.1; here smaller, for the efficiency (96), which rectifies
-#: the drive torque: at 1e-3 the paper scene's full order moved by 4e-4 over 3 s, at 1e-4 by 1e-4,
-#: benchmarks/RESULTS.md, item 53) ...
+#: the drive torque: the paper scene's full-order efficiency over 3 s moved by 4e-5 at 1e-4; measured on the
+#: step's error rows alone, by 7e-4 at 1e-3 and 1e-4 at 1e-4; benchmarks/RESULTS.md, item 53) ...
 SETTLED_SHARE = 1e-4
 #: ... and each of the drive's multipliers by less than this share of the largest it has been: four orders
 #: below the 1 % that the efficiency, which reads the drive torque lambda_4, is asked to meet ...
@@ -189,21 +189,21 @@ class NewmarkNewton:
             """The iterate as the step's result, when the next update (dq, dmu) is negligible against what the
             step's error and the efficiency may be (SETTLED_SHARE, SETTLED_FORCE_SHARE): the iterate whose
             residual is still above the tolerance need not be moved and evaluated once more.  Measured: a
-            quarter of the paper scene's evaluations saved, its efficiency unchanged to 1e-5 (benchmarks/RESULTS.md,
-            item 53)."""
+            quarter of the paper scene's evaluations saved, its efficiency unchanged to 1e-5
+            (benchmarks/RESULTS.md, item 53)."""
             if self.settle_length is None or len(norms) < 2 or norms[-1] > SETTLED_CONTRACTION * norms[-2]:
                 return None
             if not self._moves_less_than(dq, SETTLED_SHARE * self.settle_length):
                 return None
             if np.any(np.abs(dmu) > SETTLED_FORCE_SHARE * self._multiplier_level):
                 return None
-            return accepted(iteration, q, mu, ev, gap, scales[-1])  # the scale check measured this iterate by
+            return accepted(iteration, q, mu, ev, gap, scales[-1])  # the scale check measured this iterate with
 
         q = state.q + dt * state.qd + 0.5 * dt * dt * state.qdd
         mu = state.mu.copy()
         stale = self._internal_parts is None or self._steps_since_tangent >= self.tangent_reuse
         ev = evaluate(q, mu, ALL_PARTS if stale and self.model.internal.state_dependent else NO_PART)
-        norms, scales = [], []  # the residual norm and force scale of every iterate of this step, as check sees them
+        norms, scales = [], []  # the residual norm and force scale of each iterate of this step, as check sees them
 
         def trial(q, mu):
             """An iterate's evaluation.  Newton that contracts slowly although its tangent is fresh has an
