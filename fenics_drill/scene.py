@@ -165,9 +165,10 @@ class Time:
                             "(time.dt = -1) [-]; 2 is the paper's step 1/(2 f_max) of Section 6.2, which leaves "
                             "the efficiency (96) 4-7 % high against the step-converged full order: the drive "
                             "torque's oscillation, which (98) counts only while it drives, is not resolved. "
-                            "8 leaves 0.3-0.6 % on 30-50 m strings and 2.4 % on the paper scene over 10 s, "
-                            "whose efficiency converges at first order (time.dt = 3e-4: 1.5 %; "
-                            "docs/verification.md)", lambda x: x >= 2.0, ">= 2 (Nyquist)")
+                            "8 leaves 0.3-0.6 % on 30-50 m strings and 0.35 % on the paper scene over 10 s "
+                            "(against the same model with the bit's transitions resolved); a smaller step of "
+                            "the full order resolves frequencies above the band, whose efficiency is lower "
+                            "(docs/verification.md)", lambda x: x >= 2.0, ">= 2 (Nyquist)")
     newmark_alpha: float = key(0.015, "alpha of Newmark's gamma = 1/2 + alpha, beta = (1/2 + gamma)^2 / 4 "
                                "(Section 4.3) [-]", lambda x: 0 <= x <= 0.5, "in [0, 0.5]")
     adaptive: bool = key(True, "refine the step where the local error estimate exceeds time.error_tolerance")

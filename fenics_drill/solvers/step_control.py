@@ -3,7 +3,8 @@
 The nominal step resolves the band's highest frequency f_max with ``time.band_steps`` steps per period:
 8 by default, 2 in the paper (1/(2 f_max)).  At the paper's step Newmark misses part of the drive torque's
 oscillation, which the input power (98) counts while the torque drives, and the efficiency (96) comes out
-4-7 % high against the step-converged full order; at the default 0.3-2.4 % (docs/verification.md).
+4-7 % high against the step-converged full order; at the default 0.3-0.6 % against the same model with the
+bit's transitions resolved, or the full order over the same band (docs/verification.md).
 
 The local error of a Newmark step is estimated as in Zienkiewicz & Xie (1991):
 e = (beta - 1/6) dt^2 (qdd_{n+1} - qdd_n), measured against ``time.error_tolerance`` on
