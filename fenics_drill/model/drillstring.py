@@ -80,6 +80,7 @@ class DrillstringModel:
                                        disc.properties.outer_radius * space.rows(disc.vertex_dofs(THETA_X))])
         self.operators = operators
         self.exact_internal, self.hyper_reduction, self.training_states = None, None, []  # set by with_sample
+        self._kept_internal_tangent = None  # (coefficients, parts, their sum) of the last tangent
 
     @property
     def size(self) -> int:
@@ -245,13 +246,24 @@ class DrillstringModel:
     def _tangent(self, coefficients, internal_parts, evaluations, drive):
         """c_u dr/dq + c_v dr/dqd + c_a dr/dqdd of the residual of :meth:`evaluate`."""
         c_u, c_v, c_a = coefficients
-        terms = [(c, part) for c, part in zip(coefficients, internal_parts) if c != 0]
+        terms = [(1.0, self._internal_tangent(coefficients, internal_parts))]
         inertia = self.drive.inertia_tangent(c_a)
         if inertia is not None:
             terms.append((1.0, inertia))
         load_tangents = [force.tangent(evaluations[force.name], c_u, c_v) for force in self.forces]
         terms += [(-1.0, t) for t in [*load_tangents, self.drive.tangent(drive, c_u, c_v)] if t is not None]
         return self.space.combine(terms)
+
+    def _internal_tangent(self, coefficients, parts):
+        """c_u df/dq + c_v df/dqd + c_a df/dqdd of the internal force, kept for the next tangent with the same
+        parts and coefficients (Newmark's steps of one size while the parts are kept): one sum of three
+        matrices instead of one per tangent."""
+        kept = self._kept_internal_tangent
+        if kept is not None and kept[0] == coefficients and all(a is b for a, b in zip(kept[1], parts)):
+            return kept[2]
+        matrix = self.space.combine([(c, part) for c, part in zip(coefficients, parts) if c != 0])
+        self._kept_internal_tangent = (coefficients, parts, matrix)
+        return matrix
 
     def kinetic_energy(self, q, qd) -> float:
         """Kinetic energy (24) of the string plus that of the top drive."""

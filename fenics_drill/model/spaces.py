@@ -174,11 +174,19 @@ class ModalSpace:
         return sla.solve(matrix, rhs, check_finite=False)
 
     def combine(self, terms) -> np.ndarray:
-        """sum of c A over the (c, A) of ``terms``: a tangent from its parts."""
-        out = np.zeros((self.size, self.size))
+        """sum of c A over the (c, A) of ``terms``: a tangent from its parts (a new matrix; the terms of
+        c = +-1 are added in place, without a scaled copy)."""
+        out = None
         for c, matrix in terms:
-            out += c * matrix
-        return out
+            if out is None:
+                out = matrix.copy() if c == 1.0 else c * matrix
+            elif c == 1.0:
+                out += matrix
+            elif c == -1.0:
+                out -= matrix
+            else:
+                out += c * matrix
+        return np.zeros((self.size, self.size)) if out is None else out
 
     @staticmethod
     def _factorise(tangent: np.ndarray, constraints: np.ndarray):
