@@ -163,11 +163,10 @@ class TopDrive:
 
     def applied(self, mu: np.ndarray, loads: DriveLoads) -> tuple[float, float]:
         """(force along x, torque) the drive applies at x = 0: -lambda for a held dof, the load otherwise."""
-        values, k = [], 0
-        for held, load in zip(self.held, (loads.axial_force, loads.torque)):
-            values.append(-float(mu[k]) if held else load)
-            k += int(held)
-        return values[0], values[1]
+        axial_held, rotation_held = self.held.tolist()
+        multipliers = iter(mu.tolist())  # in the order of the held rows
+        force = -next(multipliers) if axial_held else loads.axial_force
+        return force, -next(multipliers) if rotation_held else loads.torque
 
     # --- inertia of the top drive --------------------------------------------------------------------------
 
