@@ -55,9 +55,10 @@ class EnergyBudget:
         self.input_work += 0.5 * float((old.drive + new.drive) @ (new.drive_displacement - old.drive_displacement))
         self.input_work += 0.5 * float((old.drive_loads + new.drive_loads) @ dq)
         self.dissipated["damping"] += 0.5 * float((old.damping + new.damping) @ dq)
-        for name in {**old.laws, **new.laws}:  # a law present at one end of the step only works from that end
-            total = sum(laws[name] for laws in (old.laws, new.laws) if name in laws)
-            self.work_by_law[name] = self.work_by_law.get(name, 0.0) + 0.5 * float(total @ dq)
+        work = self.work_by_law
+        for terms in (old.laws, new.laws):  # a law present at one end of the step only works from that end
+            for name, law in terms.items():
+                work[name] = work.get(name, 0.0) + 0.5 * float(law @ dq)
 
     def record(self, kinetic: float, strain: float, potential: float) -> None:
         """Set the mechanical energy of the current state (potential: of the point forces)."""
