@@ -38,11 +38,6 @@ from fenics_drill.studies.prepare import prepare
 #: (docs/verification.md).
 RESOLVING_BAND_STEPS = Time.band_steps
 
-#: A reduced model of a string shorter than this [m] is told that its efficiency (96) is not verified: on 20 m,
-#: 40 m, 100 m and 300 m strings the default reduced model is within 0.9 % of the full order, on a 10 m string
-#: 2-5 % low (rop within 0.1 %), and a wider band does not close that gap (docs/verification.md, "Short strings").
-SHORTEST_VERIFIED_LENGTH = 20.0
-
 #: A run whose string went deeper into the wall than this share of the gap is reported "suspect": the
 #: Hunt-Crossley law (17) models a stiff wall, so a deep penetration means the time step or the contact
 #: stiffness does not resolve the impacts.
@@ -267,10 +262,6 @@ def quantities_of_run(series_path: Path) -> dict:
         advice.append(f"the nominal step resolves the band's f_max with {band_steps:.3g} steps per period (the "
                       f"default {RESOLVING_BAND_STEPS:g}): the efficiency (96) may come out several % high (4-7 % "
                       "at the paper's 2, docs/verification.md); rop is not affected")
-    if scene.reduction.rule != "none" and scene.beam.length < SHORTEST_VERIFIED_LENGTH:
-        advice.append(f"the reduced model is verified on strings of {SHORTEST_VERIFIED_LENGTH:g} m and longer: on a "
-                      "10 m string its efficiency (96) came out 2-5 % low (rop within 0.1 %, docs/verification.md); "
-                      "reduction.rule = 'none' solves the full order, about 3x slower on such a string")
     if scene.model.contact and not data["vertices_in_contact"].any():
         advice.append("the string never touched the wall: model.contact = false gives the same answer "
                       "without paying for contact")
