@@ -30,7 +30,7 @@ def main() -> None:
         wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
     print(f"wall {wall:.1f} s, cpu {cpu:.1f} s, steps {s['steps']}, Newton iterations {s['newton_iterations']}, "
           f"rop {s['rop'] * 3600:.4f} m/h, efficiency {s['efficiency']:.5f}, "
-          f"max von Mises {s['max_von_mises']['value'] / 1e6:.3f} MPa")
+          f"max von Mises {s.get('max_von_mises', {'value': float('nan')})['value'] / 1e6:.3f} MPa")
 
 
 if __name__ == "__main__":
