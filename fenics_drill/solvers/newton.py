@@ -11,6 +11,7 @@ residual norm decreases stops that.  What counts as converged is the caller's.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -41,10 +42,21 @@ def backtrack(trial, norm0: float, step: float = 1.0, kink=None):
     return step, norm, payload
 
 
+@dataclass
+class KeptTangent:
+    """The tangent a Newton solve last used, offered to the next solve of the same system (a modified Newton
+    across Newmark steps of one size: the same tangent and its factorisation, Deuflhard 2004, Sec. 2.1).
+    Its owner empties it when the system changes (another step size, internal tangent parts assembled
+    afresh)."""
+
+    matrix: object = None
+
+
 def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np.ndarray, q: np.ndarray,
                   mu: np.ndarray, evaluation, check: Callable, max_iterations: int,
                   first_step: Callable[[np.ndarray], float] | None = None, reuse_rate: float = 0.0,
-                  kink_step: Callable | None = None, settled: Callable | None = None):
+                  kink_step: Callable | None = None, settled: Callable | None = None,
+                  kept: KeptTangent | None = None):
     """Iterate from (q, mu), whose ``evaluation`` (with ``.residual`` and ``.tangent``) is given.
 
     ``evaluate(q, mu)`` evaluates a trial state.  Before each update
@@ -59,17 +71,20 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
     law along it (None if there is none before the full update): the line search's second trial.
     ``settled(iteration, q, mu, evaluation, dq, dmu, gap)`` may stop with a verdict once the next update
     (dq, dmu) is known to be negligible, before it is taken (an iterate need not be evaluated again to
-    learn that it is converged).  Returns None when ``max_iterations`` updates did not satisfy ``check``.
+    learn that it is converged).  ``kept``: the first update takes its tangent, if it holds one, and the
+    rate test above judges it as any kept tangent; it holds this solve's last tangent on return.  Returns
+    None when ``max_iterations`` updates did not satisfy ``check``.
     """
     norm = math.sqrt(evaluation.residual @ evaluation.residual)
-    tangent = None
+    kept = KeptTangent() if kept is None else kept
+    tangent = kept.matrix
     for iteration in range(1, max_iterations + 1):
         gap = constraints @ q - target
         verdict = check(iteration, q, mu, evaluation, norm, gap)
         if verdict is not None:
             return verdict
         if tangent is None:
-            tangent = evaluation.tangent
+            tangent = kept.matrix = evaluation.tangent
         dq, dmu = space.saddle_solve(tangent, constraints, -evaluation.residual, -gap)
         if settled is not None:
             verdict = settled(iteration, q, mu, evaluation, dq, dmu, gap)
@@ -89,5 +104,5 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
         else:
             step, norm, ((q, mu), evaluation) = backtrack(trial, norm, 1.0, kink)
         if step < 1.0 or norm > reuse_rate * previous:
-            tangent = None
+            tangent = kept.matrix = None
     return None

@@ -93,3 +93,38 @@ def test_the_kink_step_lands_just_past_zero_on_the_far_side(value, change):
 @pytest.mark.parametrize("value, change", [(1.0, 2.0), (-1.0, 0.5), (1.0, 0.0)])
 def test_no_kink_step_where_the_update_does_not_cross_zero(value, change):
     assert step_past_kink(value, change) is None
+
+
+def test_a_kept_tangent_starts_newton_and_one_that_contracts_too_slowly_is_replaced():
+    """``kept`` (solvers/newton.py): the first update takes the tangent of an earlier solve, and the rate test
+    judges it like any kept tangent.  On r(y) = y + y^3 - 1 (root y* = 0.6823278...), from y = 0.7: a tangent
+    close to r'(y*) = 2.397 shrinks |r| by 0.014, then 0.0016, per update and is kept to the end; one of
+    r'(0) = 1 (a different system) overshoots (|r| grows by 1.4), the line search halves the update, and a
+    halved update has the fresh tangent taken at the next iterate.  Both converge to the same root."""
+    from fenics_drill.solvers.newton import KeptTangent
+
+    class Cubic:
+        def __init__(self, y):
+            self.residual = np.array([y[0] + y[0] ** 3 - 1.0])
+            self.y = y[0]
+
+        @property
+        def tangent(self):
+            fresh.append(self.y)
+            return np.array([[1.0 + 3.0 * self.y**2]])
+
+    def check(iteration, y, mu, ev, norm, gap):
+        return y[0] if norm <= 1e-13 else None
+
+    root = 0.6823278038280193  # the real root of y^3 + y - 1 (Cardano)
+    for slope, replaced in ((2.4, False), (1.0, True)):
+        fresh = []
+        kept = KeptTangent(np.array([[slope]]))
+        y0 = np.array([0.7])
+        result = saddle_newton(lambda y, mu: Cubic(y), ModalSpace(np.eye(1)), np.zeros((0, 1)), np.zeros(0), y0,
+                               np.zeros(0), Cubic(y0), check, 40, reuse_rate=0.1, kept=kept)
+        # |r| <= 1e-13 with r' ~ 2.4 near the root: within 1e-13 of it
+        assert result == pytest.approx(root, abs=1e-13)
+        assert bool(fresh) == replaced
+        # what the solve leaves for the next one: the tangent it used last
+        assert kept.matrix[0, 0] == (1.0 + 3.0 * fresh[-1] ** 2 if replaced else slope)
