@@ -28,7 +28,7 @@ STATE_VARIABLES = {
                  "(minus the motor torque of a top-drive controller)"),
     "top_velocity": ("m/s", "axial velocity of the top u_dot(0)"),
     "top_angular_velocity": ("rad/s", "angular velocity of the top theta_x_dot(0)"),
-    "impacts": ("1", "vertices whose wall contact began during the step"),
+    "impacts": ("1", "vertices whose wall impact began during the step: contact after moving clear of the wall"),
     "section_v": ("m", "lateral displacement v at the recorded section"),
     "section_w": ("m", "lateral displacement w at the recorded section"),
     "section_v_velocity": ("m/s", "lateral velocity v_dot at the recorded section"),
@@ -111,7 +111,7 @@ class StepRows:
         force, torque = self.model.drive.applied(s.mu, record.evaluation.drive)
         row = {
             "time": s.t, "dt": record.dt, "newton_iterations": record.newton_iterations,
-            "lambda_1": -force, "lambda_4": -torque, "impacts": np.count_nonzero(record.onsets),
+            "lambda_1": -force, "lambda_4": -torque, "impacts": np.count_nonzero(record.impacts),
             "kinetic_energy": kinetic, "strain_energy": strain, "input_work": work, "dissipated_energy": dissipated,
             **self.absent,
         }

@@ -16,6 +16,7 @@ import numpy as np
 from fenics_drill.model.drillstring import DrillstringModel, Evaluation
 from fenics_drill.model.hyper_reduction import CHECK_INTERVAL
 from fenics_drill.solvers.energy_budget import EnergyBudget, PowerTerms
+from fenics_drill.solvers.impacts import ImpactCounter
 from fenics_drill.solvers.newmark import NewmarkNewton, NewtonFailure, State
 from fenics_drill.solvers.step_control import StepController
 
@@ -28,7 +29,7 @@ class StepRecord:
     dt: float
     newton_iterations: int
     evaluation: Evaluation
-    onsets: np.ndarray  # vertices whose contact began during the step (bool per vertex)
+    impacts: np.ndarray  # vertices whose impact began during the step (bool per vertex; solvers/impacts.py)
     in_contact: np.ndarray  # vertices in contact at the end of the step
     budget: EnergyBudget | None  # None in a simulation that keeps no budget
     step_index: int
@@ -47,8 +48,7 @@ class Simulation:
         self.stepper = NewmarkNewton(model, scene.time.newmark_alpha, solver.newton_tolerance,
                                      solver.newton_max_iterations, solver.tangent_reuse, scene.time.error_tolerance)
         self.controller = StepController(scene, self.stepper.beta, model.error_rows)
-        n_vertices = len(model.disc.vertex_x)
-        self.impacts_per_vertex = np.zeros(n_vertices, dtype=np.int64)
+        self.impacts = ImpactCounter(len(model.disc.vertex_x), model.gap)
         self.stats = {"steps": 0, "rejected_steps": 0, "newton_failures": 0, "newton_iterations": 0,
                       "min_dt": np.inf, "max_dt": 0.0, "forced_steps": 0, "max_penetration": 0.0,
                       "sampling_checks": 0, "max_sampling_error": 0.0, "sample_retrainings": 0}
@@ -84,10 +84,10 @@ class Simulation:
         wall = ev.forces.get("wall")
         return float(wall.delta.max(initial=0.0)) if wall is not None else 0.0
 
-    def _contact(self, ev: Evaluation, previous: np.ndarray) -> np.ndarray:
-        """Vertices in contact with the wall at an evaluated state (``previous`` when contact is off)."""
-        wall = ev.forces.get("wall")
-        return wall.in_contact if wall is not None else previous
+    @property
+    def impacts_per_vertex(self) -> np.ndarray:
+        """Impacts counted at each vertex so far."""
+        return self.impacts.per_vertex
 
     def _check_sample(self, state: State) -> None:
         """Every CHECK_INTERVAL: the element sample against all elements; retrained where it misses
@@ -115,10 +115,11 @@ class Simulation:
             budget.record(*self.mechanical_energy(state, ev))
             powers = self._power_terms(state, ev)
         self.budget = budget
-        in_contact = self._contact(ev, np.zeros(len(self.impacts_per_vertex), bool))
+        self.impacts.start(ev.forces.get("wall"))
         clock = time.perf_counter()
         self.last_state = state
         if on_step is not None:
+            in_contact = self.impacts.in_contact
             on_step(StepRecord(state, 0.0, 0, ev, np.zeros_like(in_contact), in_contact, budget, 0))
         while state.t < t_end * (1 - 1e-12):
             dt = self.controller.step_towards(state.t, t_end)
@@ -140,19 +141,18 @@ class Simulation:
                 new_powers = self._power_terms(new, new_ev)
                 budget.advance(powers, new_powers, new.q - state.q)
                 budget.record(*self.mechanical_energy(new, new_ev))
-            new_contact = self._contact(new_ev, in_contact)
-            onsets = new_contact & ~in_contact
-            self.impacts_per_vertex += onsets
+            impacts = self.impacts.step(new_ev.forces.get("wall"))
             self.stats["steps"] += 1
             self.stats["min_dt"] = min(self.stats["min_dt"], dt)
             self.stats["max_dt"] = max(self.stats["max_dt"], dt)
             self.stats["forced_steps"] = self.controller.forced_steps
             self.stats["max_penetration"] = max(self.stats["max_penetration"], self._penetration(new_ev))
-            state, ev, powers, in_contact = new, new_ev, new_powers, new_contact
+            state, ev, powers = new, new_ev, new_powers
             self.last_state = state
             self._check_sample(state)
             if on_step is not None:
-                on_step(StepRecord(state, dt, iterations, ev, onsets, in_contact, budget, self.stats["steps"]))
+                on_step(StepRecord(state, dt, iterations, ev, impacts, self.impacts.in_contact, budget,
+                                   self.stats["steps"]))
             if progress is not None:
                 progress(state.t, t_end, self.stats, dt, time.perf_counter() - clock)
         return state

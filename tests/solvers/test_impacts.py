@@ -1,0 +1,89 @@
+"""Wall impacts: contact onsets of vertices that had moved clear of the wall (solvers/impacts.py)."""
+
+from types import SimpleNamespace
+
+import numpy as np
+from fenics_drill.solvers.impacts import IMPACT_CLEARANCE, ImpactCounter
+from tests.conftest import scene_with
+
+GAP = 0.015
+
+
+def wall_at(delta, vertices=None, count=4):
+    """What the counter reads of a wall evaluation: the evaluated vertices, their indentations and the
+    contact flags over all vertices."""
+    vertices = np.arange(count) if vertices is None else np.asarray(vertices)
+    delta = np.asarray(delta, dtype=float)
+    in_contact = np.zeros(count, dtype=bool)
+    in_contact[vertices[delta > 0]] = True
+    return SimpleNamespace(vertices=vertices, delta=delta, in_contact=in_contact)
+
+
+def test_a_contact_counts_as_an_impact_only_after_the_vertex_moved_clear_of_the_wall():
+    clearance = IMPACT_CLEARANCE * GAP
+    counter = ImpactCounter(4, GAP)
+    # vertex 0 rests on the wall, 1 is near it, 2 is clear of it, 3 is far (left out of the evaluation)
+    every = np.arange(3)
+    counter.start(wall_at([1e-8, -0.5 * clearance, -0.01], every))
+    # 0 flickers off by nanometres and back, 1 touches from within the clearance, 2 lands: one impact
+    counter.step(wall_at([-2e-9, -0.5 * clearance, -0.001], every))
+    landed = counter.step(wall_at([1e-8, 1e-8, 1e-8], every))
+    assert landed.tolist() == [False, False, True, False]
+    # 2 bounces by more than the clearance and lands again: a second impact; 0 flickers again: none
+    counter.step(wall_at([-2e-9, 1e-8, -2 * clearance], every))
+    again = counter.step(wall_at([1e-8, 1e-8, 1e-8], every))
+    assert again.tolist() == [False, False, True, False]
+    # the wall's culled set changes: 3 comes in from far away and lands, an impact
+    near = np.arange(4)
+    counter.step(wall_at([1e-8, 1e-8, 1e-8, -0.004], near))
+    arrived = counter.step(wall_at([1e-8, 1e-8, 1e-8, 1e-9], near))
+    assert arrived.tolist() == [False, False, False, True]
+    assert counter.per_vertex.tolist() == [0, 0, 2, 1]
+
+
+def test_a_vertex_left_out_by_the_culling_has_moved_clear_and_its_next_contact_is_an_impact():
+    """The wall leaves out the vertices farther than half the gap (WallContact.NEAR): one that drops out of the
+    evaluated set after a contact has left the wall by far more than the clearance."""
+    counter = ImpactCounter(2, GAP)
+    counter.start(wall_at([1e-8, 1e-8], [0, 1], count=2))
+    counter.step(wall_at([1e-8], [0], count=2))  # vertex 1 flew off and is left out
+    back = counter.step(wall_at([1e-8, 1e-8], [0, 1], count=2))
+    assert back.tolist() == [False, True]
+
+
+def test_a_thin_string_resting_on_the_wall_flickers_at_its_contact_edges_without_impacts():
+    """A 20 m string of thin pipe (60/45 mm in an 80 mm borehole) lies on the wall at a few vertices. As it
+    starts drilling, the edges of its contact zones leave the wall and touch it again: 80 contact onsets in
+    0.3 s (measured). The vertices lift by less than 0.1 um, the scale of the wall springs' indentation
+    (k_FS1 = 1e10 N/m under hundreds of newtons), far below the clearance of 1e-3 of the gap (20 um): no impacts."""
+    from fenics_drill.solvers.time_loop import Simulation
+    from fenics_drill.studies.prepare import prepare
+
+    scene = scene_with("beam.length=20.0", "beam.elements=40", "beam.outer_radius=0.06", "beam.inner_radius=0.045",
+                       "borehole.radius=0.08")
+    prepared = prepare(scene)
+    model = prepared.model
+    simulation = Simulation(model, scene, energy_budget=False)
+    v_rows, w_rows = model.lateral_rows
+    onsets, lifts = [0], []
+    separation = {}
+
+    def on_step(record):
+        radius = np.hypot(v_rows @ record.state.q, w_rows @ record.state.q)
+        clear = model.gap - radius  # > 0: away from the wall
+        if separation:
+            started = record.in_contact & ~separation["contact"]
+            onsets[0] += int(np.count_nonzero(started))
+            lifts.extend(separation["largest"][started].tolist())
+            largest = np.maximum(separation["largest"], clear)
+        else:
+            largest = clear
+        separation["largest"] = np.where(record.in_contact, 0.0, largest)
+        separation["contact"] = record.in_contact.copy()
+
+    simulation.run(simulation.initial_state(prepared.equilibrium.q), 0.3, on_step=on_step)
+    assert onsets[0] > 20  # the flicker is there (measured 80), or this tests nothing
+    # how far the flickering vertices left the wall: measured at most 9.2e-8 m; 5e-7 m bounds it with room and
+    # stays forty times below the clearance
+    assert max(lifts) < 5e-7 < IMPACT_CLEARANCE * model.gap / 40
+    assert simulation.impacts_per_vertex.sum() == 0
