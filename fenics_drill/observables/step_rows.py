@@ -111,7 +111,7 @@ class StepRows:
         force, torque = self.model.drive.applied(s.mu, record.evaluation.drive)
         row = {
             "time": s.t, "dt": record.dt, "newton_iterations": record.newton_iterations,
-            "lambda_1": -force, "lambda_4": -torque, "impacts": np.count_nonzero(record.impacts),
+            "lambda_1": -force, "lambda_4": -torque, "impacts": len(record.impacts),
             "kinetic_energy": kinetic, "strain_energy": strain, "input_work": work, "dissipated_energy": dissipated,
             **self.absent,
         }

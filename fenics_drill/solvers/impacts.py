@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from fenics_drill.model.compiled import kernel
+
 #: The share of the gap a vertex must have moved away from the wall, since its last contact, for its next
 #: contact to count as an impact: 15 um on the paper's string, 1.5 times the step control's displacement
 #: tolerance (time.error_tolerance = 1e-5 m), so a lift the integrator does not resolve is no impact.  The
@@ -21,42 +23,58 @@ import numpy as np
 IMPACT_CLEARANCE = 1e-3
 
 
+@kernel
+def _impacts_at(vertices, delta, in_contact, clear, per_vertex, clearance):
+    """The contacts of one accepted state at the evaluated ``vertices`` (indentations ``delta``): the vertices
+    whose impact began, also counted in ``per_vertex``; ``in_contact`` and ``clear`` (per vertex) updated in
+    place.  One pass over the evaluated vertices: it runs at every accepted step."""
+    began = np.empty(vertices.size, dtype=np.int64)
+    count = 0
+    for k in range(vertices.size):
+        i = vertices[k]
+        touching = delta[k] > 0.0
+        if touching and not in_contact[i] and clear[i]:
+            began[count] = i
+            count += 1
+            per_vertex[i] += 1
+        if touching:
+            clear[i] = False
+        elif delta[k] < -clearance:
+            clear[i] = True
+        in_contact[i] = touching
+    return began[:count]
+
+
 class ImpactCounter:
     """The impacts at every vertex, from the wall's evaluations at the accepted states of a run (its
     :class:`~fenics_drill.model.forces.wall_contact.WallForces`, or None without a wall)."""
 
     def __init__(self, vertex_count: int, gap: float):
         self.per_vertex = np.zeros(vertex_count, dtype=np.int64)
-        self.in_contact = np.zeros(vertex_count, dtype=bool)
+        self.in_contact = np.zeros(vertex_count, dtype=bool)  # at the last accepted state
         self.clearance = IMPACT_CLEARANCE * gap
-        # whether each vertex moved clear of the wall since its last contact
+        # whether each vertex moved clear of the wall since its last contact (one never evaluated is far)
         self._clear = np.ones(vertex_count, dtype=bool)
         self._evaluated = None  # the vertices the wall evaluated at the last accepted state
 
     def start(self, wall) -> None:
         """The initial state: a vertex counts as clear if the wall left it out (farther than its near
         share of the gap) or it is more than the clearance away."""
-        if wall is None:
-            return
-        self.in_contact = wall.in_contact
-        self._clear[wall.vertices] = wall.delta < -self.clearance
-        self._evaluated = wall.vertices
+        if wall is not None:
+            self._clear[wall.vertices] = wall.delta < -self.clearance
+            self.step(wall)
 
     def step(self, wall) -> np.ndarray:
-        """The vertices whose impact began during the step that ended at this accepted state (bool per
-        vertex), counted in :attr:`per_vertex`."""
+        """The vertices whose impact began during the step that ended at this accepted state (their
+        indices), counted in :attr:`per_vertex`."""
         if wall is None:
-            return np.zeros_like(self.in_contact)
-        contact = wall.in_contact
-        impacts = contact & ~self.in_contact & self._clear
-        self.per_vertex += impacts
-        self.in_contact = contact
+            return np.zeros(0, dtype=np.int64)
         if wall.vertices is not self._evaluated:
-            # the wall's culled set changed: the vertices it left out are more than half the gap away
-            # (WallContact.NEAR), far beyond the clearance
-            dropped = np.setdiff1d(self._evaluated, wall.vertices, assume_unique=True)
-            self._clear[dropped] = True
+            if self._evaluated is not None:
+                # the wall's culled set changed: the vertices it left out are more than half the gap away
+                # (WallContact.NEAR), far beyond the clearance, and out of contact
+                dropped = np.setdiff1d(self._evaluated, wall.vertices, assume_unique=True)
+                self._clear[dropped], self.in_contact[dropped] = True, False
             self._evaluated = wall.vertices
-        self._clear[wall.vertices[wall.delta < -self.clearance]] = True
-        self._clear[contact] = False
-        return impacts
+        return _impacts_at(wall.vertices, wall.delta, self.in_contact, self._clear, self.per_vertex,
+                           self.clearance)

@@ -29,7 +29,7 @@ class StepRecord:
     dt: float
     newton_iterations: int
     evaluation: Evaluation
-    impacts: np.ndarray  # vertices whose impact began during the step (bool per vertex; solvers/impacts.py)
+    impacts: np.ndarray  # the vertices whose impact began during the step (indices; solvers/impacts.py)
     in_contact: np.ndarray  # vertices in contact at the end of the step
     budget: EnergyBudget | None  # None in a simulation that keeps no budget
     step_index: int
@@ -119,8 +119,8 @@ class Simulation:
         clock = time.perf_counter()
         self.last_state = state
         if on_step is not None:
-            in_contact = self.impacts.in_contact
-            on_step(StepRecord(state, 0.0, 0, ev, np.zeros_like(in_contact), in_contact, budget, 0))
+            on_step(StepRecord(state, 0.0, 0, ev, np.zeros(0, dtype=np.int64), self.impacts.in_contact.copy(),
+                               budget, 0))
         while state.t < t_end * (1 - 1e-12):
             dt = self.controller.step_towards(state.t, t_end)
             model.start_step(state.t + dt)
@@ -151,7 +151,7 @@ class Simulation:
             self.last_state = state
             self._check_sample(state)
             if on_step is not None:
-                on_step(StepRecord(state, dt, iterations, ev, impacts, self.impacts.in_contact, budget,
+                on_step(StepRecord(state, dt, iterations, ev, impacts, self.impacts.in_contact.copy(), budget,
                                    self.stats["steps"]))
             if progress is not None:
                 progress(state.t, t_end, self.stats, dt, time.perf_counter() - clock)
