@@ -53,7 +53,8 @@ class TimeSeriesWriter:
             x.attrs["units"], x.attrs["long_name"] = "m", "x of the mesh vertices"
             x.make_scale("vertex_x")
             counts = f.create_dataset("impacts_per_vertex", data=np.zeros(len(vertex_x)))
-            counts.attrs["units"], counts.attrs["long_name"] = "1", "wall impacts per vertex (contact after moving clear of the wall)"
+            counts.attrs["units"] = "1"
+            counts.attrs["long_name"] = "wall impacts per vertex (contact after moving clear of the wall)"
             counts.dims[0].attach_scale(x)
             for name, basis, what in (("modes", modes, "natural frequencies of the band B (Eq. 62)"),
                                       ("modes_drive_held", held_modes, "natural frequencies of the band B with "
