@@ -27,6 +27,26 @@ def state(disc, **fields):
     return dofs
 
 
+def cantilever(disc, kappa0):
+    """A cantilever bent by a tip load as the elements hold it: theta_z, the P1 interpolant of
+    kappa0 (x - x^2 / 2L), and v its integral (piecewise quadratic, held exactly), so no shear strain; its
+    curvature kappa0 (1 - x / L) falls linearly from x = 0, and each element carries its mean."""
+    L = disc.properties.length
+    vertices = np.unique(disc.vertex_x)
+    h = np.diff(vertices)
+    slope = kappa0 * (vertices - 0.5 * vertices**2 / L)  # theta_z = v' at the vertices
+
+    def theta_z(x):
+        return np.interp(x, vertices, slope)
+
+    def v(x):
+        k = np.clip(np.searchsorted(vertices, x, side="right") - 1, 0, len(h) - 1)
+        at_vertices = np.concatenate(([0.0], np.cumsum(0.5 * h * (slope[:-1] + slope[1:]))))
+        return at_vertices[k] + 0.5 * (x - vertices[k]) * (slope[k] + theta_z(x))
+
+    return state(disc, v=v, tz=theta_z)
+
+
 def test_von_mises_of_uniform_axial_strain_is_e_times_green_lagrange_strain(disc):
     e = 2e-4
     p = disc.properties
@@ -66,19 +86,45 @@ def test_von_mises_of_pure_bending_is_e_kappa_r_plus_the_green_lagrange_stretch(
 def test_the_pruned_maximum_is_the_maximum_over_every_sampled_section(disc):
     """maximum() samples only the sections whose bound reaches a sampled stress; on random states of
     every field (bending, torsion, shear, stretch mixed) it must find exactly what sampling every
-    section finds (the same arithmetic on the same points: equal to round-off), and maxima() of all the
-    states at once what maximum() finds for each."""
+    section and the two recovered ends finds (the same arithmetic on the same points: equal to round-off),
+    and maxima() of all the states at once what maximum() finds for each."""
     rng = np.random.default_rng(7)
     probe = VonMisesProbe(disc)
     states = [1e-3 * rng.normal(size=disc.ndofs) * rng.uniform(0.0, 1.0, size=disc.ndofs) ** 4 for _ in range(20)]
+    # and cantilevers with a little of everything else, whose stress recovered at the held end is the largest
+    states += [cantilever(disc, rng.uniform(1e-5, 1e-4)) + 1e-7 * rng.normal(size=disc.ndofs) for _ in range(10)]
     values, places = probe.maxima(np.array(states))  # all states in one call, as the step rows ask
+    at_ends = 0
     for dofs, in_batch, batch_place in zip(states, values, places):
         value, where = probe.maximum(dofs)
-        everywhere = probe.stress(dofs)
+        everywhere = np.concatenate((probe.stress(dofs).ravel(), probe.end_stress(dofs)))
         k = int(np.argmax(everywhere))
-        assert value == pytest.approx(everywhere.flat[k], rel=1e-14)
-        assert where == probe.x.flat[k]
+        assert value == pytest.approx(everywhere[k], rel=1e-14)
+        assert where == np.concatenate((probe.x.ravel(), probe.end_x))[k]
         assert (in_batch, batch_place) == (value, where)  # the same arithmetic, state by state
+        at_ends += k >= probe.x.size
+    # both kinds of maxima occur (measured: 3 at the ends), or half of this tests nothing
+    assert 0 < at_ends < len(states)
+
+
+def test_the_stress_recovered_at_a_held_end_is_exact_for_a_moment_that_falls_linearly(disc):
+    """A cantilever's moment under a tip load falls linearly from the held end, M(x) = M0 (1 - x / L): v'' =
+    kappa0 (1 - x / L), theta_z = v' (no shear).  The linear rotations give each element its mean curvature,
+    so the end element's sampled stress is that of its middle, E kappa0 (1 - h / 2L) R, low by h / 2L (1/16
+    on 8 elements; :func:`cantilever` carries no shear strain).  Extrapolated from the two end elements'
+    midpoints the end's stress is exact for a linear moment, E kappa0 R (to round-off: 1e-12), and the
+    maximum is that, at x = 0.  Linear strains, so that nothing else varies along the string."""
+    kappa0 = 1e-5
+    p = disc.properties
+    R, L, E = p.outer_radius, p.length, p.young_modulus
+    h = L / 8
+    bent = cantilever(disc, kappa0)
+    probe = VonMisesProbe(disc, geometric_nonlinearity=False)
+    # the P1 interpolant of theta_z has the exact mean curvature in each element: its middle's, h / 2 in
+    assert probe.stress(bent).max() == pytest.approx(E * kappa0 * R * (1 - h / (2 * L)), rel=1e-12)
+    value, where = probe.maximum(bent)
+    assert value == pytest.approx(E * kappa0 * R, rel=1e-12)
+    assert where == 0.0
 
 
 #: A threshold crossing is located to one sample: two crossings per period of 1000 samples.
