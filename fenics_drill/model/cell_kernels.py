@@ -99,16 +99,24 @@ def _assemble_cells_at(address, offset, rows, row_function, row_dof, state, cons
     that slice of ``state``) at dof ``row_dof[i]``, row ``row_dof[i]`` of ``basis`` times them; the result
     projected on ``basis`` if ``projected`` (a vector or matrix), else summed as it is (a number)."""
     n = basis.shape[1]
-    padded = np.zeros(3 * n)  # the state of one to three functions (U; U, V; U, V, A)
-    padded[:state.size] = state
-    values = np.empty((basis.shape[0], 3))  # (dofs, functions): one pass over the rows, three sums at a time
+    functions = state.size // n  # one to three (U; U, V; U, V, A)
+    values = np.zeros((basis.shape[0], 3))  # (dofs, functions): one pass over the rows, the sums at a time
     for d in range(basis.shape[0]):         # (BLAS is slower for so few columns)
         u = v = a = 0.0
-        for j in range(n):
-            b = basis[d, j]
-            u += b * padded[j]
-            v += b * padded[n + j]
-            a += b * padded[2 * n + j]
+        if functions == 1:  # an energy of U alone: a third of the products
+            for j in range(n):
+                u += basis[d, j] * state[j]
+        elif functions == 2:
+            for j in range(n):
+                b = basis[d, j]
+                u += b * state[j]
+                v += b * state[n + j]
+        else:
+            for j in range(n):
+                b = basis[d, j]
+                u += b * state[j]
+                v += b * state[n + j]
+                a += b * state[2 * n + j]
         values[d, 0], values[d, 1], values[d, 2] = u, v, a
     packed = offset.copy()
     for i in range(rows.size):

@@ -204,11 +204,13 @@ def test_a_sampled_run_drills_as_the_unsampled_one_and_its_budget_closes():
 
 
 def test_the_indicator_retrains_a_sample_that_the_motion_outgrows(tmp_path):
-    """A 1000 m string sags on: by 0.3-0.5 s the sample trained on 0.1 s misses 2.8 % of the nonlinear
-    force (measured), the indicator retrains it, and the run ends as the unsampled one (1e-6 on the
-    rop: retrained to 1e-4 of a nonlinear force that is itself a small part of the whole), with the
-    same energy balance (within 5 %: measured 1.13e-4 against 1.14e-4; a retraining changes the sampled
-    energy by about the training tolerance)."""
+    """A 1000 m string sags on: by 0.3-0.5 s the sample trained on 0.1 s misses 2.5 % of the nonlinear
+    force (measured), the indicator retrains it, and the run ends as the unsampled one, with the same
+    energy balance (within 5 %: measured 3.21e-5 against 3.23e-5; a retraining changes the sampled energy by
+    about the training tolerance).  The rop of this start-up moves by about 1 % of the sample's error:
+    measured 2.9e-4 without retraining (2.5 % missed), and 1.5e-4, 3.7e-5, 1.8e-5 with RETRAIN_ABOVE at 1 %
+    (the default), 0.3 % and 0.1 %.  So the bound 2e-4 is what a sample retrained once it misses 1 % may
+    leave, and one that is never retrained exceeds it as soon as it misses 2 %."""
     from fenics_drill.studies.run import run_scene
 
     long = ("beam.length=1000.0", "beam.elements=100", "time.t_end=0.5", "output.field_interval=0",
@@ -216,5 +218,5 @@ def test_the_indicator_retrains_a_sample_that_the_motion_outgrows(tmp_path):
     sampled = run_scene(scene_with(*long), tmp_path / "sampled", progress=False)
     exact = run_scene(scene_with(*long, "reduction.hyper=false"), tmp_path / "exact", progress=False)
     assert sampled["hyper_reduction"]["retrainings"] >= 1
-    assert sampled["rop"] == pytest.approx(exact["rop"], rel=1e-6)
+    assert sampled["rop"] == pytest.approx(exact["rop"], rel=2e-4)
     assert sampled["energy"]["balance_error"] == pytest.approx(exact["energy"]["balance_error"], rel=0.05)

@@ -152,6 +152,38 @@ def test_tip_compliance_under_the_bit_loads_is_exact_with_the_default_basis():
         assert tip == pytest.approx(exact, rel=1e-8)
 
 
+def test_the_held_top_carries_the_whole_wall_friction_of_a_resting_string_with_the_default_basis():
+    """The paper string rests on the wall; sliding along it, the axial friction (18) of every resting vertex
+    adds up in the string's axial force, which the held top carries: E A u'(0) = sum of the friction loads (a
+    bar held at x = 0, free at the bit, nodal loads: the FE strain of the first element is exact).  The band's
+    axial modes miss 28 % of that static response and half of the strain at the top, where the peak stress
+    sits; the guard finds it and the enrichment adds it (fenics_drill/model/enrichment.py)."""
+    scene = load_scene(PAPER, ["model.geometric_nonlinearity=false", "model.inertial_nonlinearity=false"])
+    from fenics_drill.model.drillstring import build_model
+    from fenics_drill.model.enrichment import StaticSolver, wall_friction_loads, wall_rest_load
+    from fenics_drill.model.operators import assemble_linear
+
+    model = build_model(scene)
+    verdict = model.guard["wall_axial_friction"]
+    assert verdict["error_modes"] > scene.reduction.guard_tolerance and verdict["added"]
+    disc, operators = model.disc, assemble_linear(model.disc)
+    statics = StaticSolver(disc, operators)
+    gap = scene.borehole.radius - scene.beam.outer_radius
+    reaction = wall_rest_load(disc, operators.gravity, statics.responses(operators.gravity)[:, 0], gap)
+    load = wall_friction_loads(disc, reaction)["wall_axial_friction"]
+    K = model.space.project_matrix(operators.stiffness)
+    B = model.constraints
+    system = np.block([[K, B.T * K.diagonal().max()], [B * K.diagonal().max(), np.zeros((2, 2))]])
+    q = np.linalg.solve(system, np.concatenate([model.space.project(load), np.zeros(2)]))[: model.size]
+    first, second = np.argsort(disc.vertex_x)[:2]
+    u = model.space.rows(disc.vertex_dofs(U)[[first, second]]) @ q
+    p = disc.properties
+    axial_force = p.young_modulus * p.section.area * (u[1] - u[0]) / (disc.vertex_x[second] - disc.vertex_x[first])
+    carried = load[disc.vertex_dofs(U)].sum() - load[disc.vertex_dofs(U)[first]]  # the held vertex's own is held
+    # the added static response is in the basis up to its M-orthogonalisation's round-off (error 1e-6 of energy)
+    assert axial_force == pytest.approx(carried, rel=1e-4)
+
+
 def test_the_guard_refuses_a_basis_that_misses_the_sag_and_enrichment_fixes_it():
     """A 6 m string: the paper's flexural band (f <= 5 Hz) holds no flexural mode, so its modes miss
     the whole sag. With enrichment off the command stops, naming the load and the remedy; with the
