@@ -63,7 +63,7 @@ PARTS = (
 def main() -> None:
     timed(time_loop.NewmarkNewton, "step", "Newton steps")
     timed(time_loop.Simulation, "_power_terms", "power terms of the budget")
-    timed(time_loop.Simulation, "mechanical_energy", "energies of the budget")
+    timed(time_loop.EnergyBudget, "_settle", "energies of the budget (batched)")
     timed(time_loop.Simulation, "_check_sample", "sample checks")
     timed(time_loop.EnergyBudget, "advance", "budget advance")
     timed(time_loop.StepController, "error_ratio", "error estimate")

@@ -91,13 +91,11 @@ def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, si
     return out
 
 
-@kernel(fastmath=REASSOCIATE)
-def _assemble_cells_at(address, offset, rows, row_function, row_dof, state, constants, coordinates, cell_dofs, size,
-                       square, basis, projected):
-    """:func:`_assemble_cells` with the packed coefficients ``offset`` plus the functions' values at the dofs:
-    entry ``rows[i]`` of the packed array is the value of function ``row_function[i]`` (its reduced values are
-    that slice of ``state``) at dof ``row_dof[i]``, row ``row_dof[i]`` of ``basis`` times them; the result
-    projected on ``basis`` if ``projected`` (a vector or matrix), else summed as it is (a number)."""
+@njit(cache=True, fastmath=set(REASSOCIATE))
+def _packed_at(offset, rows, row_function, row_dof, state, basis):
+    """The packed coefficients ``offset`` plus the functions' values at the dofs: entry ``rows[i]`` is the value
+    of function ``row_function[i]`` (its reduced values are that slice of ``state``) at dof ``row_dof[i]``, row
+    ``row_dof[i]`` of ``basis`` times them."""
     n = basis.shape[1]
     functions = state.size // n  # one to three (U; U, V; U, V, A)
     values = np.zeros((basis.shape[0], 3))  # (dofs, functions): one pass over the rows, the sums at a time
@@ -121,10 +119,34 @@ def _assemble_cells_at(address, offset, rows, row_function, row_dof, state, cons
     packed = offset.copy()
     for i in range(rows.size):
         packed[rows[i]] += values[row_dof[i], row_function[i]]
+    return packed
+
+
+@kernel(fastmath=REASSOCIATE)
+def _assemble_cells_at(address, offset, rows, row_function, row_dof, state, constants, coordinates, cell_dofs, size,
+                       square, basis, projected):
+    """:func:`_assemble_cells` from the packed coefficients of :func:`_packed_at`, the result projected on
+    ``basis`` if ``projected`` (a vector or matrix), else summed as it is (a number)."""
+    packed = _packed_at(offset, rows, row_function, row_dof, state, basis)
     projection = basis if projected else np.empty((basis.shape[0], 0))
     out = _zeros_for(size, square, projection)
     _add_cells(address, packed.reshape(coordinates.shape[0], -1), constants, coordinates, cell_dofs, size, square,
                projection, out)
+    return out
+
+
+@kernel(fastmath=REASSOCIATE)
+def _functionals_at(address, offset, rows, row_function, row_dof, states, constants, coordinates, cell_dofs, basis):
+    """A functional (a form of rank 0) at each row of ``states``, as :func:`_assemble_cells_at` gives it for one:
+    one call for many states (the energies of a batch of accepted steps)."""
+    out = np.empty(states.shape[0])
+    none = np.empty((basis.shape[0], 0))
+    for s in range(states.shape[0]):
+        packed = _packed_at(offset, rows, row_function, row_dof, states[s], basis)
+        value = np.zeros(1)
+        _add_cells(address, packed.reshape(coordinates.shape[0], -1), constants, coordinates, cell_dofs, 1, False,
+                   none, value)
+        out[s] = value[0]
     return out
 
 
@@ -255,3 +277,10 @@ class CellAssembly:
         return self._shaped(_assemble_cells_at(self.address, offset, rows, row_function, row_dof, state,
                                                self.constants, self.coordinates, self.cell_dofs, self.size,
                                                self.rank == 2, basis, self.rank > 0))
+
+    def functionals(self, offset, rows, row_function, row_dof, states, basis) -> np.ndarray:
+        """A functional's value at each row of ``states`` (:meth:`projected` of each, in one call)."""
+        if self.rank != 0:
+            raise ValueError("functionals() takes a form of rank 0")
+        return _functionals_at(self.address, offset, rows, row_function, row_dof, np.ascontiguousarray(states),
+                               self.constants, self.coordinates, self.cell_dofs, basis)

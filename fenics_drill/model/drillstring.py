@@ -269,6 +269,13 @@ class DrillstringModel:
         """Kinetic energy (24) of the string plus that of the top drive."""
         return self.internal.kinetic_energy(q, qd) + self.drive.kinetic_energy(qd)
 
+    def mechanical_energies(self, qs: np.ndarray, qds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic (24, with the top drive's) and strain (30) energies of many states (rows of qs and qds)."""
+        kinetic, strain = self.internal.energies(qs, qds)
+        if self.drive.inertia:
+            kinetic = kinetic + np.array([self.drive.kinetic_energy(qd) for qd in qds])
+        return kinetic, strain
+
     def potential_energy(self, evaluation: Evaluation) -> float:
         """Energy stored by the point forces at an evaluated state (gravity, wall springs)."""
         potential = 0.0

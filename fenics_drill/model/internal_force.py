@@ -32,6 +32,11 @@ from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.operators import LinearOperators
 
 
+def quadratic_forms(matrix: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """x^T A x / 2 for each row x of ``rows`` (A symmetric)."""
+    return 0.5 * np.einsum("ij,ij->i", rows, rows @ matrix)
+
+
 class LinearInternalForce:
     """M qdd + C qd + K q with projected constant matrices (Eqs. 44-46)."""
 
@@ -55,6 +60,10 @@ class LinearInternalForce:
 
     def strain_energy(self, q) -> float:
         return 0.5 * float(q @ (self.stiffness @ q))
+
+    def energies(self, qs: np.ndarray, qds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic and strain energies of many states (rows of qs and qds)."""
+        return quadratic_forms(self.mass, qds), quadratic_forms(self.stiffness, qs)
 
     def damping_force(self, qd) -> np.ndarray:
         return self.damping @ qd
@@ -252,19 +261,36 @@ class AssembledInternalForce:
         return tuple(self._part(k) if want else None for k, want in enumerate(needed))
 
     def kinetic_energy(self, q, qd) -> float:
-        if self._kernel_cells is None:
-            self._set(self.U, q)
-            self._set(self.V, qd)
-            return fem.assemble_scalar(self._kinetic)
-        energy = self._kinetic_cells.assemble(np.concatenate((q, qd)))
-        return energy if self.sample is None else energy + 0.5 * float(qd @ (self.linear[2] @ qd))
+        return float(self._kinetic_energies(q[None, :], qd[None, :])[0])
 
     def strain_energy(self, q) -> float:
+        return float(self._strain_energies(q[None, :])[0])
+
+    def energies(self, qs: np.ndarray, qds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic (24) and strain (30) energies of many states (rows of qs and qds): in a modal space one
+        compiled call per energy for all of them (the budget's energies of a batch of accepted steps)."""
+        return self._kinetic_energies(qs, qds), self._strain_energies(qs)
+
+    def _kinetic_energies(self, qs, qds) -> np.ndarray:
         if self._kernel_cells is None:
-            self._set(self.U, q)
-            return fem.assemble_scalar(self._strain)
-        energy = self._strain_cells.assemble(q)
-        return energy if self.sample is None else energy + 0.5 * float(q @ (self.linear[0] @ q))
+            energies = []
+            for q, qd in zip(qs, qds):
+                self._set(self.U, q)
+                self._set(self.V, qd)
+                energies.append(fem.assemble_scalar(self._kinetic))
+            return np.array(energies)
+        energies = self._kinetic_cells.assemble_rows(np.hstack((qs, qds)))
+        return energies if self.sample is None else energies + quadratic_forms(self.linear[2], qds)
+
+    def _strain_energies(self, qs) -> np.ndarray:
+        if self._kernel_cells is None:
+            energies = []
+            for q in qs:
+                self._set(self.U, q)
+                energies.append(fem.assemble_scalar(self._strain))
+            return np.array(energies)
+        energies = self._strain_cells.assemble_rows(qs)
+        return energies if self.sample is None else energies + quadratic_forms(self.linear[0], qs)
 
     def damping_force(self, qd) -> np.ndarray:
         return self._damping @ qd
@@ -337,6 +363,10 @@ class SampledCoefficients:
         """The assembled number, or the vector or matrix projected on [Phi] (cell by cell), at the reduced
         state of the functions stacked in one vector."""
         return self.cells.projected(self.offset, self.rows, self.row_function, self.row_dof, state, self.basis)
+
+    def assemble_rows(self, states: np.ndarray) -> np.ndarray:
+        """The assembled number of a functional (an energy) at each row of ``states``, in one call."""
+        return self.cells.functionals(self.offset, self.rows, self.row_function, self.row_dof, states, self.basis)
 
 
 class TangentEntries:

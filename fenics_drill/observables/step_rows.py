@@ -50,10 +50,11 @@ class StepRows:
     """Turns accepted steps (:class:`StepRecord`) into dicts of scalars: the bit, the section, the stress,
     energies, and what each point force records (zeros for the forces the scene leaves off).
 
-    What a step's record alone knows (its time, multipliers, energies, the forces' records) is read when
+    What a step's record alone knows (its time, multipliers, works, the forces' records) is read when
     the step is taken; what follows from its state (the bit and section values, the von Mises maximum
     over the string) is computed for BATCH steps together, with one product of [Phi] with all their
-    states instead of one per step (benchmarks/RESULTS.md, item 35)."""
+    states instead of one per step (benchmarks/RESULTS.md, item 35), and its kinetic and strain energies
+    are read from the budget, which computes them in batches too (item 62)."""
 
     #: Steps whose state observables are computed together.
     BATCH = 64
@@ -76,14 +77,14 @@ class StepRows:
 
     def add(self, record: StepRecord) -> list[dict]:
         """Take an accepted step; returns the rows it completes: BATCH rows every BATCH steps, else none."""
-        self._pending.append((self._record_scalars(record), record.state))
+        self._pending.append((self._record_scalars(record), record.state, record.budget, record.step_index))
         return self.complete() if len(self._pending) >= self.BATCH else []
 
     def complete(self) -> list[dict]:
         """The rows of the steps taken and not yet returned, in their order."""
         if not self._pending:
             return []
-        scalars, states = zip(*self._pending)
+        scalars, states, budgets, steps = zip(*self._pending)
         q = np.array([s.q for s in states])
         values = np.asarray(self.point_rows @ q.T).T.tolist()  # (steps, 7)
         rates = np.asarray(self.point_rows @ np.array([s.qd for s in states]).T).T.tolist()
@@ -92,10 +93,13 @@ class StepRows:
             stresses = list(zip(largest.tolist(), where.tolist()))
         else:
             stresses = [(np.nan, np.nan)] * len(states)
+        energies = [(np.nan, np.nan) if budget is None else budget.energies_at(step)
+                    for budget, step in zip(budgets, steps)]
         rows = []
-        for known, (u, tx, v, w, *_), (du, dtx, dv, dw, dsx, du_top, dtx_top), (stress, stress_x) in zip(
-                scalars, values, rates, stresses):
-            rows.append({**known, "bit_displacement": u, "bit_velocity": du, "bit_rotation": tx,
+        for known, (u, tx, v, w, *_), (du, dtx, dv, dw, dsx, du_top, dtx_top), (stress, stress_x), (kinetic, strain) \
+                in zip(scalars, values, rates, stresses, energies):
+            rows.append({**known, "kinetic_energy": kinetic, "strain_energy": strain,
+                         "bit_displacement": u, "bit_velocity": du, "bit_rotation": tx,
                          "bit_angular_velocity": dtx, "section_v": v, "section_w": w, "section_v_velocity": dv,
                          "section_w_velocity": dw, "section_theta_x_velocity": dsx, "top_velocity": du_top,
                          "top_angular_velocity": dtx_top, "max_von_mises": stress, "max_von_mises_x": stress_x})
@@ -106,13 +110,12 @@ class StepRows:
         """The row's values that the step's record gives (all but those of its state's observables)."""
         s = record.state
         budget = record.budget
-        kinetic, strain, work, dissipated = (np.nan,) * 4 if budget is None else (
-            budget.kinetic, budget.strain, budget.input_work, budget.total_dissipated)
+        work, dissipated = (np.nan,) * 2 if budget is None else (budget.input_work, budget.total_dissipated)
         force, torque = self.model.drive.applied(s.mu, record.evaluation.drive)
         row = {
             "time": s.t, "dt": record.dt, "newton_iterations": record.newton_iterations,
             "lambda_1": -force, "lambda_4": -torque, "impacts": len(record.impacts),
-            "kinetic_energy": kinetic, "strain_energy": strain, "input_work": work, "dissipated_energy": dissipated,
+            "input_work": work, "dissipated_energy": dissipated,
             **self.absent,
         }
         for force in self.model.forces:

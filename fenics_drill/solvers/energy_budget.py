@@ -15,11 +15,17 @@ Work
 increments use the trapezoidal rule  dW = (f_n + f_{n+1}) / 2 . (q_{n+1} - q_n),
 which is exact for the average-acceleration Newmark rule (alpha = 0) on linear
 terms; with alpha > 0 the budget also shows Newmark's numerical dissipation.
+
+The kinetic and strain energies of the accepted states are computed for BATCH states at once
+(:meth:`EnergyBudget.defer`), in one compiled call per energy: at every step they cost as much as a model
+evaluation (benchmarks/RESULTS.md, item 62).  Whatever reads them settles the pending states first.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -38,17 +44,26 @@ class PowerTerms:
 @dataclass
 class EnergyBudget:
     initial_energy: float
+    #: (rows of q, rows of qd) -> (kinetic, strain energies): what :meth:`defer` computes its states' energies with
+    energies: Callable | None = None
     input_work: float = 0.0
     dissipated: dict = field(default_factory=lambda: {"damping": 0.0})
     work_by_law: dict = field(default_factory=dict)
-    energy: float = 0.0
-    kinetic: float = 0.0
-    strain: float = 0.0
-    potential: float = 0.0
+    _energy: float = 0.0
+    _kinetic: float = 0.0
+    _strain: float = 0.0
+    _potential: float = 0.0
     _scale: float = 0.0
+    _pending: list = field(default_factory=list)  # (step, q, qd, potential) of deferred states, in order
+    _by_step: dict = field(default_factory=dict)  # step -> (kinetic, strain) of the latest KEPT recorded steps
+
+    #: States whose energies are computed together.
+    BATCH: ClassVar[int] = 64
+    #: Recorded steps whose energies stay readable by step (:meth:`energies_at`; a reader takes them every BATCH).
+    KEPT: ClassVar[int] = 1024
 
     def __post_init__(self):
-        self.energy = self.initial_energy
+        self._energy = self.initial_energy
 
     def advance(self, old: PowerTerms, new: PowerTerms, dq: np.ndarray) -> None:
         """Add the work of one step."""
@@ -60,11 +75,62 @@ class EnergyBudget:
             for name, law in terms.items():
                 work[name] = work.get(name, 0.0) + 0.5 * float(law @ dq)
 
-    def record(self, kinetic: float, strain: float, potential: float) -> None:
-        """Set the mechanical energy of the current state (potential: of the point forces)."""
-        self.kinetic, self.strain, self.potential = kinetic, strain, potential
-        self.energy = kinetic + strain + potential
-        self._scale = max(self._scale, abs(self.energy - self.initial_energy), kinetic)
+    def record(self, kinetic: float, strain: float, potential: float, step: int | None = None) -> None:
+        """Set the mechanical energy of the current state (potential: of the point forces); ``step`` keeps its
+        kinetic and strain energies readable by :meth:`energies_at`."""
+        self._settle()
+        self._set(kinetic, strain, potential, step)
+
+    def defer(self, step: int, q: np.ndarray, qd: np.ndarray, potential: float) -> None:
+        """:meth:`record` of the state (q, qd), its energies computed with the next BATCH - 1 ones (or when read)."""
+        self._pending.append((step, q, qd, potential))
+        if len(self._pending) >= self.BATCH:
+            self._settle()
+
+    def _settle(self) -> None:
+        """Compute and record the energies of the deferred states, in their order."""
+        if not self._pending:
+            return
+        steps, qs, qds, potentials = zip(*self._pending)
+        self._pending.clear()
+        kinetic, strain = self.energies(np.array(qs), np.array(qds))
+        for k, s, p, step in zip(kinetic.tolist(), strain.tolist(), potentials, steps):
+            self._set(k, s, p, step)
+
+    def _set(self, kinetic: float, strain: float, potential: float, step: int | None) -> None:
+        self._kinetic, self._strain, self._potential = kinetic, strain, potential
+        self._energy = kinetic + strain + potential
+        self._scale = max(self._scale, abs(self._energy - self.initial_energy), kinetic)
+        if step is not None:
+            self._by_step[step] = (kinetic, strain)
+            if len(self._by_step) > self.KEPT:
+                del self._by_step[next(iter(self._by_step))]
+
+    def energies_at(self, step: int) -> tuple[float, float]:
+        """(kinetic, strain) energy of a recorded step, one of the latest KEPT."""
+        self._settle()
+        return self._by_step[step]
+
+    @property
+    def energy(self) -> float:
+        """Mechanical energy of the latest state."""
+        self._settle()
+        return self._energy
+
+    @property
+    def kinetic(self) -> float:
+        self._settle()
+        return self._kinetic
+
+    @property
+    def strain(self) -> float:
+        self._settle()
+        return self._strain
+
+    @property
+    def potential(self) -> float:
+        self._settle()
+        return self._potential
 
     @property
     def total_dissipated(self) -> float:
@@ -75,7 +141,7 @@ class EnergyBudget:
     def balance_error(self) -> float:
         """|E - E0 - W + D| relative to the largest energy exchanged or held."""
         residual = self.energy - self.initial_energy - self.input_work + self.total_dissipated
-        scale = max(abs(self.input_work), self.total_dissipated, self._scale, 1e-30)
+        scale = max(abs(self.input_work), self.total_dissipated, self._scale, 1e-30)  # _scale is settled now
         return abs(residual) / scale
 
     def summary(self) -> dict:

@@ -111,8 +111,9 @@ class Simulation:
         h0 = model.constraints @ state.q - model.drive_rate * state.t
         budget = powers = None
         if self.keeps_budget:
-            budget = EnergyBudget(initial_energy=sum(self.mechanical_energy(state, ev)))
-            budget.record(*self.mechanical_energy(state, ev))
+            energies = self.mechanical_energy(state, ev)
+            budget = EnergyBudget(initial_energy=sum(energies), energies=model.mechanical_energies)
+            budget.record(*energies, step=0)
             powers = self._power_terms(state, ev)
         self.budget = budget
         self.impacts.start(ev.forces.get("wall"))
@@ -136,13 +137,13 @@ class Simulation:
                 self.stats["rejected_steps"] += 1
                 continue
             model.accept(new.t, new.q, new.qd)
+            self.stats["steps"] += 1
             new_powers = None
             if budget is not None:
                 new_powers = self._power_terms(new, new_ev)
                 budget.advance(powers, new_powers, new.q - state.q)
-                budget.record(*self.mechanical_energy(new, new_ev))
+                budget.defer(self.stats["steps"], new.q, new.qd, model.potential_energy(new_ev))
             impacts = self.impacts.step(new_ev.forces.get("wall"))
-            self.stats["steps"] += 1
             self.stats["min_dt"] = min(self.stats["min_dt"], dt)
             self.stats["max_dt"] = max(self.stats["max_dt"], dt)
             self.stats["forced_steps"] = self.controller.forced_steps

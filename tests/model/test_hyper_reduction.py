@@ -62,6 +62,12 @@ def test_every_element_at_unit_weight_is_the_unsampled_model(drilling):
             assert np.linalg.norm(np.asarray(a) - np.asarray(b)) <= 1e-9 * np.linalg.norm(np.asarray(a))
         assert every.strain_energy(q) == pytest.approx(exact.strain_energy(q), rel=1e-9)
         assert every.kinetic_energy(q, qd) == pytest.approx(exact.kinetic_energy(q, qd), rel=1e-9)
+    # the energies of many states in one call (the budget's batch of accepted steps): the same sums
+    picked = states[5::40]
+    kinetic, strain = every.energies(np.array([s[0] for s in picked]), np.array([s[1] for s in picked]))
+    for k, e, (q, qd, _) in zip(kinetic, strain, picked):
+        assert e == pytest.approx(exact.strain_energy(q), rel=1e-9)
+        assert k == pytest.approx(exact.kinetic_energy(q, qd), rel=1e-9)
 
 
 def test_a_modal_models_force_and_energies_from_the_cells_kernels_are_dolfinxs_assembly(drilling):
@@ -73,6 +79,7 @@ def test_a_modal_models_force_and_energies_from_the_cells_kernels_are_dolfinxs_a
 
     scene, model, states = drilling
     internal = model.internal
+    references = []  # DOLFINx's (kinetic, strain) energies at each state
     for q, qd, qdd in states[5::40]:
         reference = model.space.project(internal.assembled_vector(q, qd, qdd))
         # the same element vectors, projected cell by cell instead of after assembly: each entry sums ~6000
@@ -85,8 +92,14 @@ def test_a_modal_models_force_and_energies_from_the_cells_kernels_are_dolfinxs_a
             function.x.array[:] = model.space.expand(values)
         # 40 cell integrals summed in another order, from dof values formed by another product with [Phi]
         # (59-term sums): round-off far below 1e-11 of energies that are all of one sign per cell
-        assert kinetic == pytest.approx(fem.assemble_scalar(internal._kinetic), rel=1e-11)
-        assert strain == pytest.approx(fem.assemble_scalar(internal._strain), rel=1e-11)
+        references.append((fem.assemble_scalar(internal._kinetic), fem.assemble_scalar(internal._strain)))
+        assert kinetic == pytest.approx(references[-1][0], rel=1e-11)
+        assert strain == pytest.approx(references[-1][1], rel=1e-11)
+    # all the states' energies in one compiled call (the budget's batch of accepted steps): the same integrals
+    picked = states[5::40]
+    kinetic, strain = internal.energies(np.array([s[0] for s in picked]), np.array([s[1] for s in picked]))
+    np.testing.assert_allclose(kinetic, [k for k, _ in references], rtol=1e-11)
+    np.testing.assert_allclose(strain, [e for _, e in references], rtol=1e-11)
 
 
 def test_the_trainers_element_forces_are_each_elements_assembled_and_projected_force(drilling):
