@@ -227,13 +227,20 @@ class DrillstringModel:
             residual += self.constraints.T @ mu
         out = Evaluation(residual, internal, external, evaluations, drive)
         if want:
-            kept = internal_parts if internal_parts is not None else (None, None, None)
-            needed = tuple(c != 0 and part is None for c, part in zip(tangent_coefficients, kept))
-            fresh = self.internal.tangent_parts(needed) if any(needed) else kept
-            parts = tuple(part if part is not None else new for part, new in zip(kept, fresh))
+            parts = internal_parts
+            if parts is None or any(part is None for part in parts):
+                parts = self._completed_parts(tangent_coefficients, parts)
             out.internal_parts = parts if all(p is not None for p in parts) else None  # reusable only if whole
             out.tangent_of = lambda: self._tangent(tangent_coefficients, parts, evaluations, drive)
         return out
+
+    def _completed_parts(self, coefficients, kept) -> tuple:
+        """The parts (df/dq, df/dqd, df/dqdd) of the internal tangent: those ``kept`` (None: none), and the
+        missing ones that a non-zero coefficient asks for computed at the state evaluated last."""
+        kept = kept if kept is not None else (None, None, None)
+        needed = tuple(c != 0 and part is None for c, part in zip(coefficients, kept))
+        fresh = self.internal.tangent_parts(needed) if any(needed) else kept
+        return tuple(part if part is not None else new for part, new in zip(kept, fresh))
 
     def kink_step(self, evaluation: Evaluation, dq: np.ndarray, c_v: float) -> float | None:
         """The fraction of a Newton update dq (qd moves by c_v dq) just past the first kink of a point

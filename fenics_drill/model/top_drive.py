@@ -75,6 +75,7 @@ class TopDrive:
         self._integral = 0.0  # z at the last accepted step [rad]
         self._last = (0.0, 0.0)  # (t, theta_x(0)) at the last accepted step
         self._t_next = 0.0
+        self._no_loads = None  # the loads of a drive that holds both dofs (read-only: shared by every evaluation)
 
     @classmethod
     def from_scene(cls, scene, disc, space) -> "TopDrive":
@@ -143,8 +144,11 @@ class TopDrive:
 
     def evaluate(self, q: np.ndarray, qd: np.ndarray) -> DriveLoads:
         """The applied weight on bit and motor torque at (q, qd) at the time of the step being solved."""
-        if self.held.all():  # the multipliers carry all the drive's loads
-            return DriveLoads(np.zeros(len(q)), 0.0, 0.0)
+        if self.held.all():  # the multipliers carry all the drive's loads: none applied, the same at every state
+            if self._no_loads is None or self._no_loads.generalised.size != len(q):
+                self._no_loads = DriveLoads(np.zeros(len(q)), 0.0, 0.0)
+                self._no_loads.generalised.flags.writeable = False
+            return self._no_loads
         force = 0.0 if self.held[AXIAL] else self.weight_on_bit
         torque = d_angle = d_speed = 0.0
         if not self.held[ROTATION]:
