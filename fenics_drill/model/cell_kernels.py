@@ -192,23 +192,25 @@ def _cell_coordinates(mesh, cells: np.ndarray) -> np.ndarray:
 
 
 class CellExpression:
-    """A ``dolfinx.fem.Expression`` of one function (block size 1) at every cell, from the function's dof
-    values: what ``Expression.eval`` gives, without packing the coefficients through DOLFINx."""
+    """A ``dolfinx.fem.Expression`` of one function (block size 1) at every cell (or at some), from the
+    function's dof values: what ``Expression.eval`` gives, without packing the coefficients through DOLFINx."""
 
-    def __init__(self, expression: fem.Expression, function: fem.Function):
+    def __init__(self, expression: fem.Expression, function: fem.Function, cells: np.ndarray | None = None):
+        """``cells``: the local cells to evaluate it at, in this order (default: all)."""
         ufcx = expression._ufcx_expression
         if ufcx.num_coefficients != 1 or function.function_space.dofmap.bs != 1:
             raise ValueError("CellExpression takes an expression of one function of block size 1")
         self.address = int(_FFI.cast("uintptr_t", ufcx.tabulate_tensor_float64))
         mesh = function.function_space.mesh
-        cells = np.arange(mesh.topology.index_map(mesh.topology.dim).size_local, dtype=np.int32)
+        if cells is None:
+            cells = np.arange(mesh.topology.index_map(mesh.topology.dim).size_local, dtype=np.int32)
         self.coordinates = _cell_coordinates(mesh, cells)
         self.cell_dofs = np.ascontiguousarray(function.function_space.dofmap.list[cells])
         self.constants = np.ascontiguousarray(fem.pack_constants(expression), dtype=float)
         self.size = expression.X().shape[0] * int(np.prod(expression.value_shape, dtype=int))
 
     def __call__(self, dofs: np.ndarray) -> np.ndarray:
-        """The expression at its points of every cell (cells x points * values)."""
+        """The expression at its points of each of its cells (cells x points * values)."""
         return _expression_at_cells(self.address, np.ascontiguousarray(dofs, dtype=float), self.cell_dofs,
                                     self.constants, self.coordinates, self.size)
 

@@ -23,6 +23,14 @@ drive) the sampled stress of the end element is the one of its middle, low by ha
 The strains' coefficients of the two end elements' midpoints, extrapolated linearly to the end vertex
 (1.5 c_1 - 0.5 c_2), recover it to second order; on the paper string at 120 rpm that gives 44.17 MPa at 500
 elements against a mesh-converged 44.2 MPa, where the sampled peak is 42.73 MPa (docs/verification.md).
+
+The maximum over the string (:meth:`VonMisesProbe.maxima`, at every accepted step) samples only both ends of
+each element, and the midpoints of the two end elements at each end for the recovery.  With P2
+displacements and P1 rotations the linear strains are affine along an element, so on each sample line of the
+outer fibre sigma_VM, the norm of an affine function of x, is convex and largest at an end of the element;
+the midpoint can hold more only through the strains' quadratic terms.  Measured on random states from 1e-5 to
+1e-1 (m, rad) of every field, for each strain model, it never did (tests/observables/test_observables.py),
+and the probe costs a third less (benchmarks/RESULTS.md, item 63).
 """
 
 from __future__ import annotations
@@ -41,6 +49,8 @@ from fenics_drill.forms.energies import green_lagrange_strains, linear_strains, 
 MONOMIALS = ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2))
 #: Points per element where the stress is evaluated (reference coordinate).
 ELEMENT_POINTS = np.array([[0.0], [0.5], [1.0]])
+#: The points of ELEMENT_POINTS where the maximum over an element lies (module doc): its ends.
+ELEMENT_ENDS = np.array([[0.0], [1.0]])
 SECTION_ANGLES = 48
 
 
@@ -122,18 +132,21 @@ def _at_ends(c, ends):
 
 
 @kernel
-def _batch_maxima(address, dofs_rows, cell_dofs, constants, coordinates, size, monomials, monomial_bounds,
-                  young_modulus, shear_modulus, ends):
-    """:func:`_largest` of each state (a row of ``dofs_rows``), its strains' coefficients from the expression
-    at ``address`` (:func:`~fenics_drill.model.cell_kernels.tabulate_at_cells`), or the stress recovered at an
-    end (:func:`_at_ends`; index points + e of end e) where that is larger: one call for many steps."""
-    strains = np.empty((cell_dofs.shape[0], size))
+def _batch_maxima(sampled, end_cells, dofs_rows, monomials, monomial_bounds, young_modulus, shear_modulus, ends):
+    """:func:`_largest` of each state (a row of ``dofs_rows``) over the strains' coefficients of the expression
+    ``sampled`` (address, cell dofs, constants, coordinates, size: :func:`~fenics_drill.model.cell_kernels.
+    tabulate_at_cells`), or the stress recovered at an end (:func:`_at_ends` of the coefficients that the
+    expression ``end_cells`` gives; index points + e of end e) where that is larger: one call for many steps."""
+    address, cell_dofs, constants, coordinates, size = sampled
+    end_address, end_dofs, end_constants, end_coordinates, end_size = end_cells
+    strains, at_end_cells = np.empty((cell_dofs.shape[0], size)), np.empty((end_dofs.shape[0], end_size))
     values, at = np.empty(dofs_rows.shape[0]), np.empty(dofs_rows.shape[0], dtype=np.int64)
     for s in range(dofs_rows.shape[0]):
         tabulate_at_cells(address, dofs_rows[s], cell_dofs, constants, coordinates, strains)
         c = strains.reshape(-1, 3, monomials.shape[0])
         values[s], at[s] = _largest(c, monomials, monomial_bounds, young_modulus, shear_modulus)
-        recovered = _at_ends(c, ends)
+        tabulate_at_cells(end_address, dofs_rows[s], end_dofs, end_constants, end_coordinates, at_end_cells)
+        recovered = _at_ends(at_end_cells.reshape(-1, 3, monomials.shape[0]), ends)
         for e in range(ends.shape[0]):
             value = _sampled_at(recovered, e, monomials, young_modulus, shear_modulus)
             if value > values[s]:
@@ -176,8 +189,15 @@ class VonMisesProbe:
         points = len(ELEMENT_POINTS)
         self.ends = np.array([[along[0], along[1]], [along[-1], along[-2]]], dtype=np.int64) * points + middle
         self.end_x = np.array([x0[along[0]], x1[along[-1]]])
-        # where each point of :meth:`maxima` sits: the sampled points, then the two ends
-        self._point_x = np.concatenate((self.x.ravel(), self.end_x))
+        # what :meth:`maxima` evaluates: the ends of every element, and all points of the four end elements
+        # (the recovery reads their midpoints: those of self.ends, numbered among these cells)
+        self._at_element_ends = CellExpression(fem.Expression(expression, ELEMENT_ENDS), self.field)
+        end_cells = np.array([along[0], along[1], along[-1], along[-2]], dtype=np.int32)
+        self._at_end_cells = CellExpression(self.expression, self.field, end_cells)
+        self._end_midpoints = np.array([[0, 1], [2, 3]], dtype=np.int64) * points + middle
+        # where each point of :meth:`maxima` sits: the elements' ends, then the two recovered ends
+        ends_x = x0[:, None] + ELEMENT_ENDS[:, 0][None, :] * (x1 - x0)[:, None]
+        self._point_x = np.concatenate((ends_x.ravel(), self.end_x))
 
     def _coefficients(self, dofs: np.ndarray) -> np.ndarray:
         """Monomial coefficients of (eps_xx, eps_xy, eps_xz) at every point: (cells * points, 3, 6)."""
@@ -199,13 +219,13 @@ class VonMisesProbe:
         """(max sigma_VM [Pa], x where it occurs [m]) over the whole string for each row of ``dofs_rows``
         (states x dofs), in one compiled call.
 
-        The larger of :meth:`stress` and :meth:`end_stress`, at a fraction of their cost: the sections are
-        sampled only where an upper bound of the stress reaches the stress sampled at the section of largest
-        bound."""
-        cells = self._at_cells
-        squared, at = _batch_maxima(cells.address, np.ascontiguousarray(dofs_rows, dtype=float), cells.cell_dofs,
-                                    cells.constants, cells.coordinates, cells.size, self.monomials,
-                                    self.monomial_bounds, self.E, self.G, self.ends)
+        The larger of :meth:`stress` at the elements' ends (where an element's largest stress lies: module
+        doc) and :meth:`end_stress`, at a fraction of their cost: the sections are sampled only where an upper
+        bound of the stress reaches the stress sampled at the section of largest bound."""
+        expressions = tuple((e.address, e.cell_dofs, e.constants, e.coordinates, e.size)
+                            for e in (self._at_element_ends, self._at_end_cells))
+        squared, at = _batch_maxima(*expressions, np.ascontiguousarray(dofs_rows, dtype=float), self.monomials,
+                                    self.monomial_bounds, self.E, self.G, self._end_midpoints)
         return np.sqrt(squared), self._point_x[at]
 
     def maximum(self, dofs: np.ndarray) -> tuple[float, float]:
