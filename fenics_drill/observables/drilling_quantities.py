@@ -18,6 +18,8 @@ Indicators (documented for users in README.md, "Drilling quantities"):
 * bit-bounce: ``off_bottom_fraction`` is the fraction of time u_dot_bit <= 0 (the
   bit-rock force (20) vanishes: the bit is not cutting); ``velocity_max_ratio``,
   ``velocity_min_ratio`` = max, min u_dot_bit / V0.
+* ringing of the bit: :func:`spin_variation_ratio`, the total variation of omega_bit over the
+  second half of a run against what a stick-slip at the string's first torsional frequency can give.
 """
 
 from __future__ import annotations
@@ -96,6 +98,20 @@ def bit_bounce(t, bit_velocity, axial_velocity: float) -> dict:
         out["velocity_max_ratio"] = float(v.max() / axial_velocity)
         out["velocity_min_ratio"] = float(v.min() / axial_velocity)
     return out
+
+
+def spin_variation_ratio(t, bit_angular_velocity, rotation_speed: float, torsional_frequency: float) -> float:
+    """sum |omega_bit(t_{n+1}) - omega_bit(t_n)| over the second half of the run, divided by 4 Omega f_T T: the
+    most that a stick-slip cycle at f_T (the string's first torsional frequency c_T / 4L), swinging omega_bit
+    between 0 and 2 Omega, adds over that half's duration T.  A bit that rings at the basis's top
+    frequencies, zig-zagging from step to step, gives tens to hundreds (docs/verification.md); NaN without
+    spin or without a second half."""
+    t, w = np.asarray(t), np.asarray(bit_angular_velocity)
+    late = t >= 0.5 * t[-1]
+    duration = t[-1] - t[late][0] if late.any() else 0.0
+    if rotation_speed == 0 or duration <= 0 or torsional_frequency <= 0:
+        return float("nan")
+    return float(np.abs(np.diff(w[late])).sum() / (4.0 * abs(rotation_speed) * torsional_frequency * duration))
 
 
 #: Impacts further apart than this belong to different shock packages (Section 6.7) [s].

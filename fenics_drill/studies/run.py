@@ -23,7 +23,7 @@ from fenics_drill.io.timeseries import TimeSeriesWriter, read_series
 from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.model.modes import drive_held_modes
 from fenics_drill.model.resources import check_memory
-from fenics_drill.observables.drilling_quantities import drilling_quantities
+from fenics_drill.observables.drilling_quantities import drilling_quantities, spin_variation_ratio
 from fenics_drill.observables.step_rows import StepRows
 from fenics_drill.scene import Time
 from fenics_drill.solvers.static import StaticFailure, static_report
@@ -42,6 +42,32 @@ RESOLVING_BAND_STEPS = Time.band_steps
 #: Hunt-Crossley law (17) models a stiff wall, so a deep penetration means the time step or the contact
 #: stiffness does not resolve the impacts.
 PENETRATION_LIMIT = 0.1
+
+#: A run with wall impacts, or with the printed kinematics, whose energy budget closes only to worse than this share
+#: of the energy exchanged is told that the time integration took that share: Newmark's numerical damping, which no
+#: physical term of the budget books.  A thin pipe's wider-band reduced model, which bounces on the wall where
+#: the full order rests, closed to 1.02 %, and to 0.04 % with time.newmark_alpha = 0 (bouncing harder: 9.11
+#: against 8.54 m/h); resting runs close within 0.25 %, the paper scene to 0.21 % (docs/verification.md).  Without impacts the damping takes the string's own
+#: stiff modes, and what it takes does not matter: a 20 m string in stick-slip closes to 0.6 %, and half the step
+#: (0.3 %) moves its rop by 0.3 % and its efficiency by 0.1 %.
+BALANCE_ADVICE = 5e-3
+
+#: A run whose bit's angular velocity varies over the second half of the run by more than this many times what
+#: a stick-slip at the string's first torsional frequency can (observables.drilling_quantities.
+#: spin_variation_ratio) is told that its bit rings.  Measured (docs/verification.md, 2026-11-24): 0.1-2.8 for
+#: every full order and every reduced model that matched it, 8.1 for the printed kinematics' chaotic reduced
+#: model, 9.7 for a 20 m string at a quarter of the default step; 40-380 for the reduced models whose bit rang
+#: (efficiency up to 2.3 % and peak stress up to 7 % off their full order).
+RINGING_RATIO = 20.0
+
+#: A run whose bit advanced by less than this many times time.error_tolerance is told that the start-up's step
+#: error weighs on its rop and efficiency.  At t = 0 the string starts with the drive's velocity against the rock,
+#: and at the default tolerance the bit recoils by a few tolerances more than the step-converged motion does
+#: (22 against 2 um in the full order, 9 um in the reduced model).  Measured (docs/verification.md, twenty-nine
+#: random scenes over 1 s): against the full order at a tenth of the tolerance, the reduced model's rop was off by
+#: 1.9 % at an advance of 24 tolerances and by 0.4-1.0 % at 43-104; beyond 200, rop and efficiency were within
+#: 0.75 % of the full order (the scene whose bit rings aside).
+START_UP_ADVANCE = 200.0
 
 
 def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
@@ -198,6 +224,7 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
                                               "max_error_found": stats["max_sampling_error"]}
             if simulation is not None:
                 _judge_admissibility(summary, simulation, scene)
+                _advise_on_energy_budget(summary, scene)
             summary["wall_time_s"] = time.perf_counter() - clock
             write_json(out / "summary.json", summary)
             claim.release()
@@ -223,6 +250,29 @@ def _judge_admissibility(summary: dict, simulation: Simulation, scene) -> None:
         summary["status"] = "suspect"
     if reasons:
         summary["suspect_reasons"] = reasons
+
+
+def _advise_on_energy_budget(summary: dict, scene) -> None:
+    """Advice for a run with impacts, or with the printed kinematics, whose energy budget does not close to
+    BALANCE_ADVICE: the share it misses was taken by Newmark's numerical damping, so the motion carries energy
+    the step does not resolve, and its drilling quantities may move with the step, the mesh or
+    time.newmark_alpha, up to another regime (docs/verification.md)."""
+    energy = summary.get("energy")
+    if energy is None or not energy["balance_error"] > BALANCE_ADVICE:
+        return
+    if scene.model.kinematics == "printed":
+        cause = "the printed kinematics' spin pumps energy into the highest modes"
+    elif summary.get("impacts_total"):
+        cause = f"the string hit the wall {summary['impacts_total']} times"
+    else:
+        return  # the damping of the string's own stiff modes (see BALANCE_ADVICE)
+    summary.setdefault("advice", []).append(
+        f"the energy budget closes only to {energy['balance_error']:.1%} of the energy exchanged "
+        f"(energy.balance_error): that share was taken by no physical law but by the time integration, Newmark's "
+        f"numerical damping (time.newmark_alpha = {scene.time.newmark_alpha:g}), because {cause}; rop and the "
+        "efficiency may then change with the step, the mesh or the basis, up to a string that rests on the wall "
+        "instead of bouncing: compare with a run at a tenth of time.error_tolerance, or with the full order "
+        "(reduction.rule = 'none') over a short horizon (docs/verification.md)")
 
 
 def _dynamics_summary(model, simulation: Simulation, recorder: RunRecorder, state, u0: float) -> dict:
@@ -262,6 +312,25 @@ def quantities_of_run(series_path: Path) -> dict:
         advice.append(f"the nominal step resolves the band's f_max with {band_steps:.3g} steps per period (the "
                       f"default {RESOLVING_BAND_STEPS:g}): the efficiency (96) may come out several % high (4-7 % "
                       "at the paper's 2, docs/verification.md); rop is not affected")
+    p = scene.beam_properties
+    ringing = spin_variation_ratio(data["time"], data["bit_angular_velocity"], scene.drive.rotation_speed,
+                                   p.torsional_wave_speed / (4.0 * p.length))
+    if np.isfinite(ringing):
+        out["bit_spin_variation_ratio"] = ringing
+    if ringing > RINGING_RATIO:
+        basis = "the model's basis" if scene.reduction.rule != "none" else "the model"
+        advice.append(f"the bit's angular velocity varies {ringing:.0f} times more over the second half of the run "
+                      "than a stick-slip at the string's first torsional frequency can: it zig-zags from step to "
+                      f"step, a stiff bit-local direction of {basis} ringing against the bit law's torque, which "
+                      "falls with the spin rate; the peak stress at the bit and the efficiency may be several % "
+                      "off: compare with the full order (reduction.rule = 'none') over a short horizon "
+                      "(docs/verification.md)")
+    advance = float(data["bit_displacement"][-1] - data["bit_displacement"][0])
+    if scene.drive.axial_velocity > 0 and advance < START_UP_ADVANCE * scene.time.error_tolerance:
+        advice.append(f"the bit advanced {advance * 1e3:.3g} mm, {advance / scene.time.error_tolerance:.0f} times "
+                      "time.error_tolerance: the start-up from the drive's velocity against the rock leaves a step "
+                      "error of a few tolerances at the bit, which can be 1-2 % of rop and efficiency here; compare "
+                      "with a run at a tenth of time.error_tolerance, or run longer (docs/verification.md)")
     if scene.model.contact and not data["vertices_in_contact"].any():
         advice.append("the string never touched the wall: model.contact = false gives the same answer "
                       "without paying for contact")

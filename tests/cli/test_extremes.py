@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from fenics_drill.cli import main
+from fenics_drill.studies.run import BALANCE_ADVICE
 
 BASE = ["--set", "beam.length=10.0", "--set", "beam.elements=10", "--set", "time.t_end=0.05",
         "--set", "output.field_interval=0.025", "--set", "reduction.rule='count'",
@@ -104,8 +105,8 @@ def test_a_scene_that_never_touches_the_wall_is_told_contact_is_not_needed(tmp_p
         out = tmp_path / contact
         assert main(["run", *BASE, "--set", f"model.contact={contact}", "--quiet", "--out", str(out)]) == 0
         results[contact] = json.loads((out / "summary.json").read_text())
-    assert "model.contact = false" in results["true"]["advice"][0]
-    assert "advice" not in results["false"]
+    assert any("model.contact = false" in a for a in results["true"]["advice"])
+    assert not any("model.contact" in a for a in results["false"].get("advice", []))
     # the same answer up to round-off and where Newton stops: it takes an iterate once its next update moves
     # the string by less than 1e-9 m (solvers/newmark.py, SETTLED_SHARE), and round-off can move that decision
     # by an iteration (measured: 3e-12; 5e-13 with Newton driven to its residual tolerance). 1e-9 is 300 times
@@ -114,7 +115,7 @@ def test_a_scene_that_never_touches_the_wall_is_told_contact_is_not_needed(tmp_p
         assert results["false"][key] == pytest.approx(results["true"][key], rel=1e-9), key
     on_wall = tmp_path / "wall"
     assert main(["run", *BASE, *[i for o in ON_WALL for i in ("--set", o)], "--quiet", "--out", str(on_wall)]) == 0
-    assert "advice" not in json.loads((on_wall / "summary.json").read_text())
+    assert not any("model.contact" in a for a in json.loads((on_wall / "summary.json").read_text()).get("advice", []))
 
 
 def test_a_run_at_a_step_too_coarse_for_the_efficiency_is_told_so(tmp_path):
@@ -127,3 +128,71 @@ def test_a_run_at_a_step_too_coarse_for_the_efficiency_is_told_so(tmp_path):
         said[name] = " ".join(json.loads((out / "summary.json").read_text()).get("advice", []))
     assert "2 steps per period" in said["paper"] and "efficiency" in said["paper"]
     assert "steps per period" not in said["default"] + said["finer"]
+
+
+def test_a_run_whose_energy_budget_the_time_integration_breaks_is_told_so(tmp_path, alarm):
+    """The printed kinematics' spin pumps energy into the highest modes, where Newmark's numerical damping (alpha)
+    takes it: the budget, which books only physical terms, misses that share (2.8 % on this 20 m string over
+    0.2 s) and the run says so.  With alpha = 0 nothing is taken: the same run closes its budget (7e-4: the
+    adaptive step's truncation) and is not told.  Nor is the consistent model without impacts, although the
+    damping takes 0.6 % there: it takes the stiff modes of the string, and half the step moves its rop by
+    0.3 % and its efficiency by 0.1 % (studies/run.py, BALANCE_ADVICE)."""
+    base = [*BASE, *[i for o in ON_WALL for i in ("--set", o)], "--set", "time.t_end=0.2"]
+    summaries = {}
+    for name, extra in (("printed", ["model.kinematics='printed'"]),
+                        ("printed, alpha = 0", ["model.kinematics='printed'", "time.newmark_alpha=0.0"]),
+                        ("consistent", [])):
+        out = tmp_path / name.replace(" ", "_").replace(",", "")
+        assert main(["run", *base, *[i for o in extra for i in ("--set", o)], "--quiet", "--out", str(out)]) == 0
+        summaries[name] = json.loads((out / "summary.json").read_text())
+    told = {name: " ".join(s.get("advice", [])) for name, s in summaries.items()}
+    error = summaries["printed"]["energy"]["balance_error"]
+    assert error > BALANCE_ADVICE
+    assert f"{error:.1%}" in told["printed"] and "newmark_alpha" in told["printed"] and "printed" in told["printed"]
+    # the missing share is the numerical damping's: without it the budget closes to the step's truncation
+    assert summaries["printed, alpha = 0"]["energy"]["balance_error"] < 0.1 * error
+    assert summaries["consistent"]["energy"]["balance_error"] > BALANCE_ADVICE
+    assert summaries["consistent"]["impacts_total"] == 0
+    assert "energy budget" not in told["printed, alpha = 0"] + told["consistent"]
+
+
+def test_a_run_whose_bit_rings_is_told_so(tmp_path, alarm):
+    """A 101 m string of 112/90 mm pipe at 39 m/h and 87 rpm (benchmarks/random_scenes_seed7.md, scene 6): from
+    0.5 s on, the default reduced model's bit rings, its angular velocity zig-zagging between 0.1 and 37 rad/s
+    from step to step while the full order's moves smoothly (docs/verification.md), and its peak stress at the
+    bit comes out 7 % high.  The bit's angular velocity then varies over the second half of the run far more
+    than a stick-slip cycle at the string's first torsional frequency can (measured 161 times over 1 s, 1.2 for
+    the full order), and the run says so.  A stick-slip that the model resolves stays near one: the paper
+    scene shortened to 20 m over 0.5 s (measured 0.59; 0.1-2.8 for every run that matched its full order, so 2 is
+    the bound asserted)."""
+    from fenics_drill.studies.run import RINGING_RATIO
+
+    ringing = ["beam.length=101.068", "beam.elements=253", "beam.outer_radius=0.056008",
+               "beam.inner_radius=0.0450352", "borehole.radius=0.0742886", "drive.axial_velocity=0.0109340101",
+               "drive.rotation_speed=9.13149305", "bit_rock.limit_force=33151.7", "bit_rock.rate=455.199",
+               "bit_rock.friction=0.4191", "time.t_end=0.8", "output.field_interval=0"]
+    out = tmp_path / "ringing"
+    assert main(["run", *[i for o in ringing for i in ("--set", o)], "--quiet", "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["bit_spin_variation_ratio"] > RINGING_RATIO
+    assert any("zig-zags from step to step" in a for a in summary.get("advice", []))
+    calm = tmp_path / "calm"
+    short = ["beam.length=20.0", "beam.elements=40", "time.t_end=0.5", "output.field_interval=0"]
+    assert main(["run", *[i for o in short for i in ("--set", o)], "--quiet", "--out", str(calm)]) == 0
+    summary = json.loads((calm / "summary.json").read_text())
+    assert summary["bit_spin_variation_ratio"] < 2.0
+    assert not any("zig-zags" in a for a in summary.get("advice", []))
+
+
+def test_a_run_whose_bit_advanced_only_a_few_step_tolerances_is_told_so(tmp_path):
+    """At t = 0 the string starts with the drive's velocity against the rock, and the start-up leaves a step error
+    of a few time.error_tolerance at the bit (docs/verification.md): over 0.05 s the 10 m string's bit advances
+    0.17 mm, 17 tolerances, and the run says so; at a hundredth of the tolerance that is 1700 of them (above the
+    threshold of 200, studies/run.py START_UP_ADVANCE) and it is not told."""
+    said = {}
+    for name, tolerance in (("default", []), ("tight", ["time.error_tolerance=1e-7"])):
+        out = tmp_path / name
+        assert main(["run", *BASE, *[i for o in tolerance for i in ("--set", o)], "--quiet", "--out", str(out)]) == 0
+        said[name] = " ".join(json.loads((out / "summary.json").read_text()).get("advice", []))
+    assert "the bit advanced" in said["default"] and "time.error_tolerance" in said["default"]
+    assert "the bit advanced" not in said["tight"]
