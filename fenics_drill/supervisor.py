@@ -66,18 +66,19 @@ def supervise(argv: list[str], command: str, out: Path | None) -> int:
                 if deadline is not None and time.monotonic() > deadline:
                     worker.kill()
                     worker.wait()
-                    _mark_killed(out, command, received[0])
+                    _mark_killed(out, command, received[0], f"the command did not stop within {GRACE_SECONDS:g} s "
+                                 "(it was inside a long computation) and was killed")
                     return 130
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)
     if code < 0:  # the worker died of a signal it could not handle (SIGKILL from outside, a crash)
-        _mark_killed(out, command, -code)
+        _mark_killed(out, command, -code, "the command died of it before it wrote its summary")
         return 128 - code
     return code
 
 
-def _mark_killed(out: Path | None, command: str, signum: int) -> None:
+def _mark_killed(out: Path | None, command: str, signum: int, how: str) -> None:
     """Say in ``out/summary.json`` that the command was ended from outside, keeping what it recorded."""
     if out is None or not out.is_dir():
         return
@@ -90,6 +91,5 @@ def _mark_killed(out: Path | None, command: str, signum: int) -> None:
         return  # not this command's directory, or the worker wrote its own final summary
     name = signal.Signals(signum).name
     summary.update(status="interrupted",
-                   message=f"ended by {name}: the command did not stop within {GRACE_SECONDS:g} s (it was inside "
-                           "a long computation) and was killed; the files hold everything up to their last write")
+                   message=f"ended by {name}: {how}; the files hold everything up to their last write")
     write_json(path, summary)

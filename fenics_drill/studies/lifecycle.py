@@ -3,7 +3,9 @@ stopping it with SIGINT (Ctrl-C) or SIGTERM (a batch system's time limit, ``kill
 
 Within :class:`StopOnSignal`, the first of either signal raises KeyboardInterrupt in the main
 thread, and every later one is ignored, so that the shutdown it starts (writing the summary,
-closing the files) cannot be cut short by a second Ctrl-C.  A signal that arrives while the
+closing the files) cannot be cut short by a second Ctrl-C.  Inside :func:`uninterrupted` (the
+recording of a step: its rows, its files, the state the summary reports) the interrupt waits until
+the block ends, so that what the files hold and what the summary says stay the same step.  A signal that arrives while the
 process is inside a long C call (a PETSc solve, the mesh of a huge scene) is only seen when the
 call returns; :mod:`fenics_drill.supervisor` bounds that wait for the command-line tool.
 """
@@ -24,27 +26,56 @@ SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 class StopOnSignal:
-    """Context manager: the first SIGINT/SIGTERM raises KeyboardInterrupt, later ones are ignored; the
-    previous handlers come back on exit (a no-op outside the main thread, where Python has no handlers)."""
+    """Context manager: the first SIGINT/SIGTERM raises KeyboardInterrupt (at the end of an
+    :func:`uninterrupted` block if it arrives inside one), later ones are ignored; the previous handlers
+    come back on exit (a no-op outside the main thread, where Python has no handlers)."""
+
+    #: The innermost StopOnSignal of this process, which :func:`uninterrupted` defers.
+    active: "StopOnSignal | None" = None
 
     def __enter__(self) -> "StopOnSignal":
         self.previous = None
+        self.deferring = 0  # depth of the uninterrupted blocks open
+        self.requested = False  # the first signal has arrived
         if threading.current_thread() is threading.main_thread():
             self.previous = {s: signal.getsignal(s) for s in SIGNALS}
             for s in SIGNALS:
                 signal.signal(s, self._first)
+            self.outer, StopOnSignal.active = StopOnSignal.active, self
         return self
 
-    @staticmethod
-    def _first(signum, frame):
+    def _first(self, signum, frame):
         for s in SIGNALS:
             signal.signal(s, signal.SIG_IGN)
-        raise KeyboardInterrupt
+        self.requested = True
+        if not self.deferring:
+            raise KeyboardInterrupt
 
     def __exit__(self, *exc) -> None:
         if self.previous is not None:
+            StopOnSignal.active = self.outer
             for s, handler in self.previous.items():
                 signal.signal(s, handler)
+
+
+@contextmanager
+def uninterrupted(stop_after: bool = True):
+    """A block that the active :class:`StopOnSignal` does not cut (a no-op outside one).  ``stop_after``
+    (the recording of a step): KeyboardInterrupt comes as the block ends if a signal has arrived, inside it
+    or before it (an interrupt raised where Python only prints exceptions, a destructor or a callback of a
+    C library, would otherwise be lost, and the run would go on until the supervisor kills it); without it
+    (the writing of a summary), the signal is ignored."""
+    stop = StopOnSignal.active
+    if stop is None:
+        yield
+        return
+    stop.deferring += 1
+    try:
+        yield
+    finally:
+        stop.deferring -= 1
+    if stop_after and stop.requested and not stop.deferring:
+        raise KeyboardInterrupt
 
 
 @contextmanager
@@ -69,7 +100,8 @@ def command_output(out: str | Path, command: str, scene, overwrite: bool = False
                 summary.update(status="failed", message=str(err))
                 raise
             finally:
-                summary["wall_time_s"] = time.perf_counter() - start
-                write_json(out / "summary.json", summary)
+                with uninterrupted(stop_after=False):  # the summary is written whatever comes
+                    summary["wall_time_s"] = time.perf_counter() - start
+                    write_json(out / "summary.json", summary)
     finally:
         claim.release()

@@ -29,7 +29,7 @@ from fenics_drill.scene import Time
 from fenics_drill.solvers.static import StaticFailure, static_report
 from fenics_drill.solvers.step_control import StepTooSmall, nominal_step, steps_per_band_period
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
-from fenics_drill.studies.lifecycle import StopOnSignal, command_output
+from fenics_drill.studies.lifecycle import StopOnSignal, command_output, uninterrupted
 from fenics_drill.studies.prepare import prepare
 
 
@@ -140,10 +140,11 @@ class RunRecorder:
             self.next_field_time = self.field_interval * (np.floor(state.t / self.field_interval + 1e-9) + 1)
 
     def __call__(self, record: StepRecord) -> None:
-        self._write_fields(record.state)
-        completed = self.rows.add(record)
-        self.last_state = record.state
-        self._append(completed)
+        with uninterrupted():  # the files, their rows and last_state stay the same step
+            self._write_fields(record.state)
+            completed = self.rows.add(record)
+            self.last_state = record.state
+            self._append(completed)
 
     def _append(self, rows: list[dict]) -> None:
         written = None  # the time of the last row written to the file
@@ -214,20 +215,21 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
         except StaticFailure as failure:
             summary["message"] = f"at t = 0 s: {failure}"
         finally:
-            if recorder is not None:
-                recorder.close(simulation.impacts_per_vertex)
-                summary.update(quantities_of_run(out / "timeseries.h5"))
-            if simulation is not None and simulation.model.hyper_reduction is not None:
-                stats = simulation.stats
-                summary["hyper_reduction"] = {**simulation.model.hyper_reduction,
-                                              "checks": stats["sampling_checks"],
-                                              "max_error_found": stats["max_sampling_error"]}
-            if simulation is not None:
-                _judge_admissibility(summary, simulation, scene)
-                _advise_on_energy_budget(summary, scene)
-            summary["wall_time_s"] = time.perf_counter() - clock
-            write_json(out / "summary.json", summary)
-            claim.release()
+            with uninterrupted(stop_after=False):  # the summary is written whatever comes
+                if recorder is not None:
+                    recorder.close(simulation.impacts_per_vertex)
+                    summary.update(quantities_of_run(out / "timeseries.h5"))
+                if simulation is not None and simulation.model.hyper_reduction is not None:
+                    stats = simulation.stats
+                    summary["hyper_reduction"] = {**simulation.model.hyper_reduction,
+                                                  "checks": stats["sampling_checks"],
+                                                  "max_error_found": stats["max_sampling_error"]}
+                if simulation is not None:
+                    _judge_admissibility(summary, simulation, scene)
+                    _advise_on_energy_budget(summary, scene)
+                summary["wall_time_s"] = time.perf_counter() - clock
+                write_json(out / "summary.json", summary)
+                claim.release()
     return summary
 
 

@@ -275,6 +275,46 @@ def test_two_quick_ctrl_c_leave_an_interrupted_summary(tmp_path):
     assert summary["status"] == "interrupted" and summary["t_end"] > 0 and "energy" in summary
 
 
+def test_a_signal_inside_the_recording_of_a_step_stops_the_run_only_after_it():
+    """The CI once saw an interrupted run whose summary named a step before the last row of its series: SIGTERM
+    had landed between the recorder's rows and its state (studies/run.py).  Inside ``uninterrupted`` a signal
+    must wait: the block runs to its end, then KeyboardInterrupt comes, and later signals are ignored."""
+    from fenics_drill.studies.lifecycle import StopOnSignal, uninterrupted
+
+    done = []
+    with pytest.raises(KeyboardInterrupt):
+        with StopOnSignal():
+            with uninterrupted():
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(0.05)  # the handler runs here, between two bytecodes
+                done.append("rows")
+                os.kill(os.getpid(), signal.SIGINT)  # a second signal: ignored
+                time.sleep(0.05)
+                done.append("state")
+            done.append("after")  # not reached: the deferred interrupt comes as the block ends
+    assert done == ["rows", "state"]
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # the handlers are given back
+
+
+def test_an_interrupt_that_something_swallowed_still_stops_the_run_at_the_next_step():
+    """A KeyboardInterrupt raised where Python only prints it (a destructor, a C library's callback) was lost:
+    the signals were ignored from then on and the run went on until the supervisor killed it, without its
+    summary.  The next step's recording must raise it again; the writing of the summary must not."""
+    from fenics_drill.studies.lifecycle import StopOnSignal, uninterrupted
+
+    with StopOnSignal():
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.05)
+        except KeyboardInterrupt:
+            pass  # swallowed
+        with uninterrupted(stop_after=False):
+            pass  # the summary's block: no interrupt
+        with pytest.raises(KeyboardInterrupt):
+            with uninterrupted():
+                pass
+
+
 # 7. Impossible states are not "finished"
 
 
