@@ -2,7 +2,7 @@
 test or table was tuned on (what a held-back check would do).
 
     python benchmarks/random_scenes.py [--scenes 8] [--seed 2026] [--t-end 1] [--runs out/random_scenes]
-                                       [--table benchmarks/random_scenes.md] [--jobs 2]
+                                       [--table benchmarks/random_scenes.md] [--jobs 2] [--lengths 30 250]
 
 Draws each scene from the paper scene by changing its length, mesh, pipe radii, gap, drive speeds and bit-rock
 law within the ranges of :data:`RANGES`, runs it with the default reduced model and with the full order
@@ -36,9 +36,9 @@ RANGES = {
 ELEMENTS_PER_M, ELEMENT_BOUNDS = 2.5, (60, 600)
 
 
-def draw(rng: np.random.Generator) -> dict:
+def draw(rng: np.random.Generator, ranges: dict = RANGES) -> dict:
     """One scene's drawn quantities."""
-    d = {key: float(rng.uniform(*bounds)) for key, bounds in RANGES.items()}
+    d = {key: float(rng.uniform(*bounds)) for key, bounds in ranges.items()}
     d["elements"] = int(np.clip(round(ELEMENTS_PER_M * d["length"]), *ELEMENT_BOUNDS))
     return d
 
@@ -65,9 +65,12 @@ def main() -> None:
     parser.add_argument("--runs", type=Path, default=Path("out/random_scenes"))
     parser.add_argument("--table", type=Path, default=Path("benchmarks/random_scenes.md"))
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--lengths", type=float, nargs=2, default=RANGES["length"], metavar=("LOW", "HIGH"),
+                        help="the range of the string's length [m]")
     args = parser.parse_args()
     rng = np.random.default_rng(args.seed)
-    scenes = [draw(rng) for _ in range(args.scenes)]
+    ranges = {**RANGES, "length": tuple(args.lengths)}
+    scenes = [draw(rng, ranges) for _ in range(args.scenes)]
     jobs = [(args.runs / f"{i}-{model}", [*overrides(d), *extra])
             for i, d in enumerate(scenes) for model, extra in (("full", ["reduction.rule='none'"]), ("reduced", []))]
     with ThreadPoolExecutor(args.jobs) as pool:
@@ -75,7 +78,7 @@ def main() -> None:
     lines = [f"# The default reduced model against its full order on {args.scenes} random scenes, "
              f"t_end = {args.t_end:g} s", "",
              f"Command: `python benchmarks/random_scenes.py --scenes {args.scenes} --seed {args.seed} "
-             f"--t-end {args.t_end:g}`. Each scene is the paper scene with the quantities below drawn uniformly "
+             f"--t-end {args.t_end:g} --lengths {args.lengths[0]:g} {args.lengths[1]:g}`. Each scene is the paper scene with the quantities below drawn uniformly "
              "(ranges in `RANGES`); reduced: its defaults; full: `reduction.rule='none'`. Differences are the "
              "reduced model's, relative to the full order.", "",
              "| # | L [m] | elements | R_ext / R_int / gap [mm] | V0 [m/h] | rpm | Gamma [kN] / alpha / mu | "

@@ -36,6 +36,11 @@ CHECK_INTERVAL = 0.1
 RETRAIN_ABOVE = 0.01
 
 
+#: A weight below this share of the largest is round-off (a column the active set took, then found no use
+#: for): it is dropped, and its element is not sampled.
+NEGLIGIBLE_WEIGHT = 1e-12
+
+
 def sparse_nnls(G: np.ndarray, b: np.ndarray, tolerance: float, max_columns: int | None = None) -> np.ndarray:
     """x >= 0 with few non-zeros and ||G x - b|| <= tolerance ||b||: Lawson & Hanson's active-set NNLS
     (1974, ch. 23), stopped as soon as the residual is within the tolerance (Farhat et al. 2014)."""
@@ -62,9 +67,10 @@ def sparse_nnls(G: np.ndarray, b: np.ndarray, tolerance: float, max_columns: int
             negative = columns[z[columns] <= 0]
             step = np.min(x[negative] / (x[negative] - z[negative]))
             x = x + step * (z - x)
-            passive &= x > 1e-12 * max(x.max(), 1e-300)
+            passive &= x > NEGLIGIBLE_WEIGHT * max(x.max(), 1e-300)
             x[~passive] = 0.0
         residual = b - G @ x
+    x[x <= NEGLIGIBLE_WEIGHT * max(x.max(), 1e-300)] = 0.0  # a column taken at round-off weight samples nothing
     return x
 
 
