@@ -16,6 +16,11 @@ grows and the step shrinks; once the motion is smooth again the step relaxes bac
 the nominal one.  Without the bit's rows a reduced model takes the start-up in one
 nominal step, and its bit velocity rings (benchmarks/reduced_accuracy.md).  A Newton
 failure halves the step; after ``time.max_step_cuts`` halvings the run stops.
+
+Over the first nominal step the tolerance is ``time.start_up_share`` of ``time.error_tolerance``: the bit,
+set moving at V0 and Omega at t = 0, is braked by the rock law's steep velocity dependence within
+microseconds, and what error that transient leaves stays in the string as a lightly damped oscillation that
+moves the efficiency of the whole run (docs/verification.md, "The start-up transient").
 """
 
 from __future__ import annotations
@@ -58,6 +63,9 @@ class StepController:
         self.minimum = self.nominal / 2 ** scene.time.max_step_cuts
         self.adaptive = scene.time.adaptive
         self.tolerance = scene.time.error_tolerance
+        # the start-up transient (time.start_up_share): a tighter tolerance over the first nominal step
+        self.start_up_end = self.nominal
+        self.start_up_tolerance = scene.time.start_up_share * self.tolerance
         self.error_factor = abs(beta - 1.0 / 6.0)
         # the maps of q to the displacements [m] the error is measured on, stacked (one product per step)
         self.error_rows = stack_rows(error_rows)
@@ -76,16 +84,18 @@ class StepController:
             return self.dt
         return remaining if remaining <= self.dt else 0.5 * remaining
 
-    def error_ratio(self, dt: float, qdd_old: np.ndarray, qdd_new: np.ndarray) -> float:
-        """Estimated local error over the tolerance (<= 1: accept); or an upper bound of it where that bound
-        already makes :meth:`judge` accept the step and propose the nominal one, as the estimate would: the
-        estimate's product with every row is then saved (most steps of a smooth motion)."""
+    def error_ratio(self, t: float, dt: float, qdd_old: np.ndarray, qdd_new: np.ndarray) -> float:
+        """Estimated local error of the step from t over the tolerance (<= 1: accept), the start-up's before
+        :attr:`start_up_end`; or an upper bound of it where that bound already makes :meth:`judge` accept the
+        step and propose the nominal one, as the estimate would: the estimate's product with every row is then
+        saved (most steps of a smooth motion)."""
+        tolerance = self.tolerance if t >= self.start_up_end else self.start_up_tolerance
         e = self.error_factor * dt * dt * (qdd_new - qdd_old)
-        bound = float(self.column_bound @ np.abs(e)) / self.tolerance
+        bound = float(self.column_bound @ np.abs(e)) / tolerance
         # (1 + 1e-9): the estimate may exceed the bound by the round-off of their sums
         if bound * (1.0 + 1e-9) <= self._nominal_ratio(dt):
             return bound
-        return float(np.max(np.abs(self.error_rows @ e))) / self.tolerance
+        return float(np.max(np.abs(self.error_rows @ e))) / tolerance
 
     def _nominal_ratio(self, dt: float) -> float:
         """The largest error ratio after a step of dt for which :meth:`judge` accepts and proposes the

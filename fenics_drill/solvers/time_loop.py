@@ -132,7 +132,7 @@ class Simulation:
                 self.controller.cut(dt, str(failure), state.t)
                 continue
             self.stats["newton_iterations"] += iterations
-            ratio = self.controller.error_ratio(dt, state.qdd, new.qdd)
+            ratio = self.controller.error_ratio(state.t, dt, state.qdd, new.qdd)
             if not self.controller.judge(dt, ratio):
                 self.stats["rejected_steps"] += 1
                 continue

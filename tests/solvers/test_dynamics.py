@@ -348,7 +348,7 @@ def test_the_error_estimates_bound_changes_no_decision_of_the_step_control(space
     for _ in range(400):
         dt = with_bound.nominal * rng.uniform(0.25, 1.0)
         qdd = 10.0 ** rng.uniform(-1, 4) * rng.standard_normal((2, model.size))
-        ratio = with_bound.error_ratio(dt, *qdd)
+        ratio = with_bound.error_ratio(1.0, dt, *qdd)  # after the start-up
         e = exact.error_factor * dt * dt * (qdd[1] - qdd[0])
         estimate = float(np.max(np.abs(exact.error_rows @ e))) / exact.tolerance
         # the bound is a sum of the same products' magnitudes: never below the estimate beyond its round-off
