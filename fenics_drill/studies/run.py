@@ -60,15 +60,6 @@ BALANCE_ADVICE = 5e-3
 #: (efficiency up to 2.3 % and peak stress up to 7 % off their full order).
 RINGING_RATIO = 20.0
 
-#: A run whose bit advanced by less than this many times time.error_tolerance is told that the start-up's step
-#: error weighs on its rop and efficiency.  At t = 0 the string starts with the drive's velocity against the rock,
-#: and at the default tolerance the bit recoils by a few tolerances more than the step-converged motion does
-#: (22 against 2 um in the full order, 9 um in the reduced model).  Measured (docs/verification.md, twenty-nine
-#: random scenes over 1 s): against the full order at a tenth of the tolerance, the reduced model's rop was off by
-#: 1.9 % at an advance of 24 tolerances and by 0.4-1.0 % at 43-104; beyond 200, rop and efficiency were within
-#: 0.75 % of the full order (the scene whose bit rings aside).
-START_UP_ADVANCE = 200.0
-
 
 def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
     """Static equilibrium of the scene (Section 6.4): DIR/static.json, DIR/static.xdmf, DIR/summary.json."""
@@ -327,12 +318,6 @@ def quantities_of_run(series_path: Path) -> dict:
                       "falls with the spin rate; the peak stress at the bit and the efficiency may be several % "
                       "off: compare with the full order (reduction.rule = 'none') over a short horizon "
                       "(docs/verification.md)")
-    advance = float(data["bit_displacement"][-1] - data["bit_displacement"][0])
-    if scene.drive.axial_velocity > 0 and advance < START_UP_ADVANCE * scene.time.error_tolerance:
-        advice.append(f"the bit advanced {advance * 1e3:.3g} mm, {advance / scene.time.error_tolerance:.0f} times "
-                      "time.error_tolerance: the start-up from the drive's velocity against the rock leaves a step "
-                      "error of a few tolerances at the bit, which can be 1-2 % of rop and efficiency here; compare "
-                      "with a run at a tenth of time.error_tolerance, or run longer (docs/verification.md)")
     if scene.model.contact and not data["vertices_in_contact"].any():
         advice.append("the string never touched the wall: model.contact = false gives the same answer "
                       "without paying for contact")
