@@ -28,7 +28,9 @@ from fenics_drill.model.discretization import THETA_X, U, V, W, BeamDiscretizati
 from fenics_drill.model.forces import ForceEvaluation, build_forces
 from fenics_drill.model.hyper_reduction import RETRAIN_ABOVE, sampling_error, train_sample
 from fenics_drill.model.internal_force import ElementSample, internal_force
+from fenics_drill.model.modes import band_frequency
 from fenics_drill.model.operators import LinearOperators, assemble_linear
+from fenics_drill.model.out_of_band_damping import OutOfBandDamping
 from fenics_drill.model.enrichment import augment
 from fenics_drill.model.spaces import FullSpace, ModalSpace, solution_space, stack_rows
 from fenics_drill.model.top_drive import DriveLoads, TopDrive
@@ -67,6 +69,11 @@ class DrillstringModel:
         self.mass = space.project_matrix(operators.mass)
         self.internal = internal_force(disc, space, operators, scene.model)
         self.forces = build_forces(scene, disc, space, operators)
+        if not space.sparse:  # a modal basis: its directions above the band damped (out_of_band_damping.py)
+            damping = OutOfBandDamping.of_basis(self.mass, space.project_matrix(operators.stiffness),
+                                                band_frequency(scene), scene.reduction.out_of_band_damping)
+            if damping is not None:
+                self.forces.append(damping)
         self.drive = TopDrive.from_scene(scene, disc, space)
         self.constraints = self.drive.constraints  # [B] of (72), k x N_red: the rows the drive holds
         self.lateral_rows = (space.rows(disc.vertex_dofs(V)), space.rows(disc.vertex_dofs(W)))

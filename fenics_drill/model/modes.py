@@ -166,6 +166,12 @@ def paper_bands(length: float, longitudinal_wave_speed: float) -> dict[str, floa
 SPIN_HARMONICS = 5.0
 
 
+def band_frequency(scene) -> float:
+    """f_max = f*_max c_L / L, the highest frequency of the band B [Hz]."""
+    p = scene.beam_properties
+    return scene.modal.f_star_max * p.longitudinal_wave_speed / p.length
+
+
 def step_band(scene) -> float:
     """The f* up to which the scene's time step resolves the motion: f*_max of the band B with the
     nominal step (time.band_steps steps per period of f_max, at least 2), or the Nyquist band L / (2 dt c_L)

@@ -27,17 +27,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from fenics_drill.model.modes import band_frequency
 from fenics_drill.model.spaces import column_bound, stack_rows
 
 
 class StepTooSmall(RuntimeError):
     """The step would have to go below dt_nominal / 2^max_step_cuts."""
-
-
-def band_frequency(scene) -> float:
-    """f_max = f*_max c_L / L, the highest frequency of the band B [Hz]."""
-    p = scene.beam_properties
-    return scene.modal.f_star_max * p.longitudinal_wave_speed / p.length
 
 
 def nominal_step(scene) -> float:

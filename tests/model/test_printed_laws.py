@@ -17,7 +17,7 @@ LAWS = {  # scene switch -> the budget's name of the law it sets
 #: A 10 m full-order string thrown at the wall while it turns and is fed, the bit drilling: every law works.
 BASE = ("beam.length=10.0", "beam.elements=4", "beam.damping=0.0", "reduction.rule='none'", "model.gravity=false",
         "model.geometric_nonlinearity=false", "model.inertial_nonlinearity=false", "model.supports='pinned'",
-        "contact.damping=3e16", "contact.friction=0.25", "time.newmark_alpha=0.0", "time.error_tolerance=1e-6",
+        "contact.damping=3e16", "contact.friction=0.25", "time.newmark_alpha=0.0", "time.error_tolerance=1e-7",
         "drive.axial_velocity=0.01", "drive.rotation_speed=6.283185307179586")
 
 
@@ -69,11 +69,12 @@ PRINTED_DAMPER = ("contact.damper_law='printed'", "contact.damping=1e4")
 def test_the_budget_closes_with_any_combination_of_laws(printed):
     """E(t) - E(0) = W_drive + sum W_law - D_damping within the consistent model's tolerance (alpha = 0),
     and each printed law's work is positive (energy injected) where the consistent law's is negative;
-    the damper dissipates either way."""
+    the damper dissipates either way.  What the budget misses is the impacts' step error: 0.8-1.0 % of the
+    energy exchanged at time.error_tolerance = 1e-6, 0.2 % at 3e-7, 0.05-0.12 % at 1e-7 (the BASE's), so 0.5 %."""
     model, simulation = kicked_run(*printed)
     budget = simulation.budget
     assert simulation.impacts_per_vertex.sum() >= 1
-    assert budget.balance_error < 1e-2, budget.summary()
+    assert budget.balance_error < 5e-3, budget.summary()
     assert budget.work_by_law["wall_damper"] < 0
     for switch, name in LAWS.items():
         made_printed = "model.laws='printed'" in printed or f"{switch}='printed'" in printed

@@ -48,8 +48,9 @@ def test_a_vertex_left_out_by_the_culling_has_moved_clear_and_its_next_contact_i
 
 def test_a_thin_string_resting_on_the_wall_flickers_at_its_contact_edges_without_impacts():
     """A 20 m string of thin pipe (60/45 mm in an 80 mm borehole) lies on the wall at a few vertices. As it
-    starts drilling, the edges of its contact zones leave the wall and touch it again: 10 contact onsets in
-    0.3 s (measured; 80 before the basis carried the wall friction's static response, docs/verification.md). The vertices lift by less than 0.1 um, the scale of the wall springs' indentation
+    starts drilling, the edges of its contact zones leave the wall and touch it again: 8 contact onsets in
+    0.6 s (measured; 10 in 0.3 s before the start-up was resolved, time.start_up_share, and 80 before the basis
+    carried the wall friction's static response, docs/verification.md). The vertices lift by less than 0.1 um, the scale of the wall springs' indentation
     (k_FS1 = 1e10 N/m under hundreds of newtons), far below the clearance of 1e-3 of the gap (20 um): no impacts."""
     from fenics_drill.solvers.time_loop import Simulation
     from fenics_drill.studies.prepare import prepare
@@ -76,8 +77,8 @@ def test_a_thin_string_resting_on_the_wall_flickers_at_its_contact_edges_without
         separation["largest"] = np.where(record.in_contact, 0.0, largest)
         separation["contact"] = record.in_contact.copy()
 
-    simulation.run(simulation.initial_state(prepared.equilibrium.q), 0.3, on_step=on_step)
-    assert onsets[0] > 5  # the flicker is there (measured 10), or this tests nothing
+    simulation.run(simulation.initial_state(prepared.equilibrium.q), 0.6, on_step=on_step)
+    assert onsets[0] > 4  # the flicker is there (measured 8), or this tests nothing
     # how far the flickering vertices left the wall: measured at most 6.6e-8 m; 5e-7 m bounds it with room and
     # stays forty times below the clearance
     assert max(lifts) < 5e-7 < IMPACT_CLEARANCE * model.gap / 40
