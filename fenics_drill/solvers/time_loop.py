@@ -8,6 +8,8 @@ It knows nothing about files: every accepted step is handed to ``on_step`` as a
 
 from __future__ import annotations
 
+import contextlib
+
 import time
 from dataclasses import dataclass
 
@@ -102,58 +104,63 @@ class Simulation:
             self.stepper.forget_tangent()
         self._next_sampling_check = CHECK_INTERVAL * (np.floor(state.t / CHECK_INTERVAL + 1e-9) + 1)
 
-    def run(self, state: State, t_end: float, on_step=None, progress=None) -> State:
+    def run(self, state: State, t_end: float, on_step=None, progress=None, atomic=contextlib.nullcontext) -> State:
         """Step from ``state`` to t_end; raises StepTooSmall (with when and why) if the step collapses.
 
-        ``on_step`` sees the initial state (step_index 0) and then every accepted step."""
+        ``on_step`` sees the initial state (step_index 0) and then every accepted step.  Each step (its Newton
+        solve, its acceptance, the budget's and the memories' updates, ``on_step``) runs inside ``atomic()``: a
+        command passes :func:`fenics_drill.studies.lifecycle.uninterrupted`, so that Ctrl-C or SIGTERM stops the
+        run between two steps, never with a step half booked."""
         model = self.model
-        ev = model.evaluate(state.q, state.qd, state.qdd, state.mu)
-        h0 = model.constraints @ state.q - model.drive_rate * state.t
-        budget = powers = None
-        if self.keeps_budget:
-            energies = self.mechanical_energy(state, ev)
-            budget = EnergyBudget(initial_energy=sum(energies), energies=model.mechanical_energies)
-            budget.record(*energies, step=0)
-            powers = self._power_terms(state, ev)
-        self.budget = budget
-        self.impacts.start(ev.forces.get("wall"))
-        clock = time.perf_counter()
-        self.last_state = state
-        if on_step is not None:
-            on_step(StepRecord(state, 0.0, 0, ev, np.zeros(0, dtype=np.int64), self.impacts.in_contact.copy(),
-                               budget, 0))
-        while state.t < t_end * (1 - 1e-12):
-            dt = self.controller.step_towards(state.t, t_end)
-            model.start_step(state.t + dt)
-            try:
-                new, iterations, new_ev = self.stepper.step(state, dt, h0)
-            except NewtonFailure as failure:
-                self.stats["newton_failures"] += 1
-                self.controller.cut(dt, str(failure), state.t)
-                continue
-            self.stats["newton_iterations"] += iterations
-            ratio = self.controller.error_ratio(state.t, dt, state.qdd, new.qdd)
-            if not self.controller.judge(dt, ratio):
-                self.stats["rejected_steps"] += 1
-                continue
-            model.accept(new.t, new.q, new.qd)
-            self.stats["steps"] += 1
-            new_powers = None
-            if budget is not None:
-                new_powers = self._power_terms(new, new_ev)
-                budget.advance(powers, new_powers, new.q - state.q)
-                budget.defer(self.stats["steps"], new.q, new.qd, model.potential_energy(new_ev))
-            impacts = self.impacts.step(new_ev.forces.get("wall"))
-            self.stats["min_dt"] = min(self.stats["min_dt"], dt)
-            self.stats["max_dt"] = max(self.stats["max_dt"], dt)
-            self.stats["forced_steps"] = self.controller.forced_steps
-            self.stats["max_penetration"] = max(self.stats["max_penetration"], self._penetration(new_ev))
-            state, ev, powers = new, new_ev, new_powers
+        with atomic():  # the initial state, booked whole
+            ev = model.evaluate(state.q, state.qd, state.qdd, state.mu)
+            h0 = model.constraints @ state.q - model.drive_rate * state.t
+            budget = powers = None
+            if self.keeps_budget:
+                energies = self.mechanical_energy(state, ev)
+                budget = EnergyBudget(initial_energy=sum(energies), energies=model.mechanical_energies)
+                budget.record(*energies, step=0)
+                powers = self._power_terms(state, ev)
+            self.budget = budget
+            self.impacts.start(ev.forces.get("wall"))
+            clock = time.perf_counter()
             self.last_state = state
-            self._check_sample(state)
             if on_step is not None:
-                on_step(StepRecord(state, dt, iterations, ev, impacts, self.impacts.in_contact.copy(), budget,
-                                   self.stats["steps"]))
-            if progress is not None:
-                progress(state.t, t_end, self.stats, dt, time.perf_counter() - clock)
+                on_step(StepRecord(state, 0.0, 0, ev, np.zeros(0, dtype=np.int64), self.impacts.in_contact.copy(),
+                                   budget, 0))
+        while state.t < t_end * (1 - 1e-12):
+            with atomic():  # a signal stops the run between steps, never inside one's bookkeeping
+                dt = self.controller.step_towards(state.t, t_end)
+                model.start_step(state.t + dt)
+                try:
+                    new, iterations, new_ev = self.stepper.step(state, dt, h0)
+                except NewtonFailure as failure:
+                    self.stats["newton_failures"] += 1
+                    self.controller.cut(dt, str(failure), state.t)
+                    continue
+                self.stats["newton_iterations"] += iterations
+                ratio = self.controller.error_ratio(state.t, dt, state.qdd, new.qdd)
+                if not self.controller.judge(dt, ratio):
+                    self.stats["rejected_steps"] += 1
+                    continue
+                model.accept(new.t, new.q, new.qd)
+                self.stats["steps"] += 1
+                new_powers = None
+                if budget is not None:
+                    new_powers = self._power_terms(new, new_ev)
+                    budget.advance(powers, new_powers, new.q - state.q)
+                    budget.defer(self.stats["steps"], new.q, new.qd, model.potential_energy(new_ev))
+                impacts = self.impacts.step(new_ev.forces.get("wall"))
+                self.stats["min_dt"] = min(self.stats["min_dt"], dt)
+                self.stats["max_dt"] = max(self.stats["max_dt"], dt)
+                self.stats["forced_steps"] = self.controller.forced_steps
+                self.stats["max_penetration"] = max(self.stats["max_penetration"], self._penetration(new_ev))
+                state, ev, powers = new, new_ev, new_powers
+                self.last_state = state
+                self._check_sample(state)
+                if on_step is not None:
+                    on_step(StepRecord(state, dt, iterations, ev, impacts, self.impacts.in_contact.copy(), budget,
+                                       self.stats["steps"]))
+                if progress is not None:
+                    progress(state.t, t_end, self.stats, dt, time.perf_counter() - clock)
         return state

@@ -191,7 +191,7 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
             summary["nominal_dt"] = nominal_step(scene)
             loop_clock = time.perf_counter()
             try:
-                final = simulation.run(start, scene.time.t_end, recorder, Progress(progress))
+                final = simulation.run(start, scene.time.t_end, recorder, Progress(progress), atomic=uninterrupted)
                 summary["status"], summary["message"] = "finished", "reached time.t_end"
             except StepTooSmall as failure:
                 final = None
