@@ -70,11 +70,12 @@ def supervise(argv: list[str], command: str, out: Path | None) -> int:
                                  "(it was inside a long computation) and was killed")
                     return 130
     finally:
-        for s, handler in previous.items():
-            signal.signal(s, handler)
-    if code < 0:  # the worker died of a signal it could not handle (SIGKILL from outside, a crash)
+        for s, handler in previous.items():  # after a signal, the later ones of the same Ctrl-C or kill are ignored
+            signal.signal(s, signal.SIG_IGN if received else handler)
+    if code < 0:  # the worker died of a signal: one it could not handle (SIGKILL from outside, a crash), or a late
+        # second Ctrl-C or SIGTERM after it had written its summary and given the handlers back
         _mark_killed(out, command, -code, "the command died of it before it wrote its summary")
-        return 128 - code
+        return 130 if received else 128 - code
     return code
 
 
