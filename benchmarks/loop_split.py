@@ -71,7 +71,7 @@ def main() -> None:
         timed(owner, name, label)
     run = time_loop.Simulation.run
 
-    def timed_run(self, state, t_end, on_step=None, progress=None):
+    def timed_run(self, state, t_end, on_step=None, progress=None, **options):
         def recorded(record):
             clock = time.perf_counter()
             try:
@@ -82,7 +82,7 @@ def main() -> None:
         clock = time.perf_counter()
         before = SPENT.copy(), CALLS.copy()
         try:
-            return run(self, state, t_end, recorded, progress)
+            return run(self, state, t_end, recorded, progress, **options)
         finally:
             SPENT["time loop"] += time.perf_counter() - clock
             LAST_RUN.clear()  # this run alone (the main run comes after the ECSW training run)

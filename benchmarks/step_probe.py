@@ -46,8 +46,8 @@ def reached_state(t_start: float):
     kept = {}
     run = time_loop.Simulation.run
 
-    def keep(self, state, t_end, on_step=None, progress=None):
-        kept["simulation"], kept["state"] = self, run(self, state, t_end, on_step, progress)
+    def keep(self, state, t_end, on_step=None, progress=None, **options):
+        kept["simulation"], kept["state"] = self, run(self, state, t_end, on_step, progress, **options)
         return kept["state"]
 
     time_loop.Simulation.run = keep
