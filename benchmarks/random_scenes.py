@@ -3,6 +3,7 @@ test or table was tuned on (what a held-back check would do).
 
     python benchmarks/random_scenes.py [--scenes 8] [--seed 2026] [--t-end 1] [--runs out/random_scenes]
                                        [--table benchmarks/random_scenes.md] [--jobs 2] [--lengths 30 250]
+                                       [--set SECTION.KEY=VALUE ...]
 
 Draws each scene from the paper scene by changing its length, mesh, pipe radii, gap, drive speeds and bit-rock
 law within the ranges of :data:`RANGES`, runs it with the default reduced model and with the full order
@@ -67,18 +68,21 @@ def main() -> None:
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--lengths", type=float, nargs=2, default=RANGES["length"], metavar=("LOW", "HIGH"),
                         help="the range of the string's length [m]")
+    parser.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                        help="an override of every scene (both models), after the drawn ones")
     args = parser.parse_args()
     rng = np.random.default_rng(args.seed)
     ranges = {**RANGES, "length": tuple(args.lengths)}
     scenes = [draw(rng, ranges) for _ in range(args.scenes)]
-    jobs = [(args.runs / f"{i}-{model}", [*overrides(d), *extra])
+    jobs = [(args.runs / f"{i}-{model}", [*overrides(d), *args.set, *extra])
             for i, d in enumerate(scenes) for model, extra in (("full", ["reduction.rule='none'"]), ("reduced", []))]
     with ThreadPoolExecutor(args.jobs) as pool:
         summaries = list(pool.map(lambda job: run_once(job[0], args.t_end, job[1]), jobs))
     lines = [f"# The default reduced model against its full order on {args.scenes} random scenes, "
              f"t_end = {args.t_end:g} s", "",
              f"Command: `python benchmarks/random_scenes.py --scenes {args.scenes} --seed {args.seed} "
-             f"--t-end {args.t_end:g} --lengths {args.lengths[0]:g} {args.lengths[1]:g}`. Each scene is the paper scene with the quantities below drawn uniformly "
+             f"--t-end {args.t_end:g} --lengths {args.lengths[0]:g} {args.lengths[1]:g}"
+             f"{''.join(f' --set {o}' for o in args.set)}`. Each scene is the paper scene with the quantities below drawn uniformly "
              "(ranges in `RANGES`); reduced: its defaults; full: `reduction.rule='none'`. Differences are the "
              "reduced model's, relative to the full order.", "",
              "| # | L [m] | elements | R_ext / R_int / gap [mm] | V0 [m/h] | rpm | Gamma [kN] / alpha / mu | "

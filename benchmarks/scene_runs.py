@@ -23,12 +23,16 @@ def study_arguments(doc: str, t_end: float, runs: str, table: str) -> argparse.N
 
 def run_once(out: Path, t_end: float, overrides: list[str]) -> dict:
     """``fenics-drill run SCENE --set time.t_end=T --set OVERRIDE...`` into ``out`` unless it already
-    finished there; returns its summary."""
+    finished there; returns its summary ({"status": "refused", "message": ...} for a scene the tool refuses)."""
     summary = out / "summary.json"
     if not (summary.exists() and json.loads(summary.read_text()).get("status") in ("finished", "suspect")):
         sets = [a for o in overrides for a in ("--set", o)]
-        subprocess.run([sys.executable, "-m", "fenics_drill.cli", "run", SCENE, "--set", f"time.t_end={t_end}",
-                        *sets, "--quiet", "--overwrite", "--out", str(out)], check=False)
+        result = subprocess.run([sys.executable, "-m", "fenics_drill.cli", "run", SCENE, "--set", f"time.t_end={t_end}",
+                                 *sets, "--quiet", "--overwrite", "--out", str(out)], check=False,
+                                stderr=subprocess.PIPE, text=True)
+        sys.stderr.write(result.stderr)
+        if not summary.exists():
+            return {"status": "refused", "message": result.stderr.strip()}
     return json.loads(summary.read_text())
 
 
