@@ -60,6 +60,13 @@ BALANCE_ADVICE = 5e-3
 #: (efficiency up to 2.3 % and peak stress up to 7 % off their full order).
 RINGING_RATIO = 20.0
 
+#: A run whose bit advanced by less than this many times time.error_tolerance is told that its rop and efficiency
+#: measure a motion of the size of a few steps' admissible error.  Measured with the start-up resolved
+#: (docs/verification.md, random scenes over 1 s, the reduced model against its full order): rop off by 28 % and
+#: 5 % at advances of 0.2 and 0.4 tolerances (strings of 490-520 m, whose bit has barely started), by 0.8 % at 7,
+#: by 0.34 % at 24, and by at most 0.13 % beyond 80.
+SMALL_ADVANCE = 20.0
+
 
 def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
     """Static equilibrium of the scene (Section 6.4): DIR/static.json, DIR/static.xdmf, DIR/summary.json."""
@@ -317,6 +324,13 @@ def quantities_of_run(series_path: Path) -> dict:
                       f"step, a stiff bit-local direction of {basis} ringing against the bit law's torque, which "
                       "falls with the spin rate; the peak stress at the bit and the efficiency may be several % "
                       "off: compare with the full order (reduction.rule = 'none') over a short horizon "
+                      "(docs/verification.md)")
+    advance = float(data["bit_displacement"][-1] - data["bit_displacement"][0])
+    if scene.drive.axial_velocity > 0 and advance < SMALL_ADVANCE * scene.time.error_tolerance:
+        advice.append(f"the bit advanced {advance * 1e6:.3g} um, {advance / scene.time.error_tolerance:.2g} times "
+                      "time.error_tolerance, the local error a step may make: rop and efficiency measure a motion of "
+                      "the size of a few steps' errors (on a long string, the bit has barely started moving) and "
+                      "may be off by several %: run longer, or at a tighter time.error_tolerance "
                       "(docs/verification.md)")
     if scene.model.contact and not data["vertices_in_contact"].any():
         advice.append("the string never touched the wall: model.contact = false gives the same answer "

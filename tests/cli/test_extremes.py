@@ -185,3 +185,22 @@ def test_a_run_whose_bit_rings_is_told_so(tmp_path, alarm):
     assert not any("zig-zags" in a for a in summary.get("advice", []))
 
 
+def test_a_run_whose_bit_advanced_only_a_few_step_tolerances_is_told_so(tmp_path):
+    """Over 0.02 s the 10 m string's bit advances 27 um, 2.7 times time.error_tolerance (the local error a step may
+    make), and its rop and efficiency measure a motion of the size of a few steps' errors: the run says so.  At a
+    hundredth of the tolerance the same advance is 275 tolerances, above the threshold of 20 (studies/run.py
+    SMALL_ADVANCE), and it is not told."""
+    from fenics_drill.studies.run import SMALL_ADVANCE
+
+    said, advance = {}, {}
+    for name, tolerance in (("default", []), ("tight", ["time.error_tolerance=1e-7"])):
+        out = tmp_path / name
+        sets = ["--set", "time.t_end=0.02", *[i for o in tolerance for i in ("--set", o)]]
+        assert main(["run", *BASE, *sets, "--quiet", "--out", str(out)]) == 0
+        summary = json.loads((out / "summary.json").read_text())
+        said[name] = " ".join(summary.get("advice", []))
+        advance[name] = summary["mean_bit_velocity"] * summary["t_end"]
+    assert advance["default"] < 0.5 * SMALL_ADVANCE * 1e-5  # the case is clear of the threshold
+    assert "the bit advanced" in said["default"] and "time.error_tolerance" in said["default"]
+    assert "the bit advanced" not in said["tight"]
+
