@@ -272,6 +272,12 @@ class Reduction:
                                  "accepts any basis (the paper's pure modal basis with enrich = false)",
                                  lambda x: 0 < x <= 1, "in (0, 1]")
 
+    rest_response_tolerance: float = key(0.01, "largest admissible share of the responses of the string at rest "
+                                         "(its tangent, with the wall's springs) to the bit force and torque and "
+                                         "the wall's friction that the basis may miss (square root of the energy "
+                                         "share); they carry the bending at the touchdown on the wall, where a "
+                                         "pinned string's peak stress sits (fenics_drill/studies/prepare.py); "
+                                         "1: none added", lambda x: 0 < x <= 1, "in (0, 1]")
 
 @dataclass(frozen=True)
 class Uncertainty:

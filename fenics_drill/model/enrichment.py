@@ -86,10 +86,10 @@ def wall_rest_load(disc: BeamDiscretization, gravity: np.ndarray, gravity_respon
 
 
 def wall_friction_loads(disc: BeamDiscretization, reaction: np.ndarray) -> dict[str, np.ndarray]:
-    """The axial friction (18) and the friction torque (19) that the wall's ``reaction`` at rest drives: at each
-    resting vertex |F_n| on u and on theta_x (a static response's shape depends neither on the friction
+    """The axial friction (18) and the friction torque (19) that the wall's ``reaction`` at rest (full-space loads
+    on v and w) drives: at each resting vertex |F_n| on u and on theta_x (a static response's shape depends neither on the friction
     coefficients, nor on R_bh, nor on the direction of sliding)."""
-    magnitude = np.abs(reaction[disc.vertex_dofs(W)])
+    magnitude = np.hypot(reaction[disc.vertex_dofs(V)], reaction[disc.vertex_dofs(W)])
     axial, torque = np.zeros(disc.ndofs), np.zeros(disc.ndofs)
     axial[disc.vertex_dofs(U)] = magnitude
     torque[disc.vertex_dofs(THETA_X)] = magnitude
@@ -111,6 +111,17 @@ def scene_loads(scene, disc: BeamDiscretization, operators: LinearOperators, sta
             if scene.contact.friction > 0:
                 loads.update(wall_friction_loads(disc, wall))
     return loads
+
+
+def tangent_responses(space, tangent, constraints: np.ndarray, loads: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """name -> full-space static response to each full-space load of ``loads`` of the string at a state whose
+    tangent dr/dq in the full ``space`` is ``tangent``, with the rows ``constraints`` held: how the state moves
+    when the load changes a little (the geometric stiffness and the wall's springs included)."""
+    out = {}
+    for name, load in loads.items():
+        response, _ = space.saddle_solve(tangent, constraints, space.project(load), np.zeros(constraints.shape[0]))
+        out[name] = space.expand(response)
+    return out
 
 
 def basis_error(phi: np.ndarray, stiffness, constraints: np.ndarray, load: np.ndarray, response: np.ndarray) -> float:

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from fenics_drill.model.drillstring import DrillstringModel, build_model
-from fenics_drill.model.enrichment import missed_share
+from fenics_drill.model.enrichment import (basis_error, bit_loads, missed_share, tangent_responses,
+                                             wall_friction_loads)
 from fenics_drill.model.hyper_reduction import train_sample
 from fenics_drill.model.internal_force import AssembledInternalForce
 from fenics_drill.model.spaces import ModalSpace
@@ -55,7 +56,8 @@ def prepare(scene, dynamics: bool = True) -> PreparedScene:
     model = build_model(scene)
     initial = None
     if isinstance(model.space, ModalSpace) and scene.reduction.enrich and scene.model.gravity:
-        model, state = _with_static_state(model, scene.reduction.guard_tolerance)
+        model, state = _with_static_state(model, scene.reduction.guard_tolerance,
+                                          scene.reduction.rest_response_tolerance)
         if state is not None:
             initial = model.space.phi.T @ (model.operators.mass @ state)  # M-orthonormal basis: the projection
     setup = time.perf_counter() - clock
@@ -108,16 +110,20 @@ def _with_element_sample(model: DrillstringModel, scene, equilibrium: StaticEqui
     return model.with_sample(sample, report, training)
 
 
-def _with_static_state(model: DrillstringModel, tolerance: float) -> tuple[DrillstringModel, np.ndarray]:
-    """The model, with the full-order static state added to its basis if the basis misses it; and that
-    state (full-space dofs), or None if the full order finds no static state (said in the guard)."""
+def _with_static_state(model: DrillstringModel, tolerance: float,
+                       rest_tolerance: float) -> tuple[DrillstringModel, np.ndarray]:
+    """The model, with the full-order static state added to its basis if the basis misses more than
+    ``tolerance`` of it, and the state's responses to the loads that change in a run if it misses more than
+    ``rest_tolerance`` of them (:func:`_with_responses_at_rest`); and that state (full-space dofs), or None if
+    the full order finds no static state (said in the guard)."""
     full = model.full_order()
     try:
-        state = full.space.expand(solve_static(full).q)
+        equilibrium = solve_static(full)
     except StaticFailure as failure:  # the reduced solve may still succeed: it is tried as it was
         model.guard = {**model.guard, "static_state": {"error": None, "added": False,
                                                        "message": f"full-order static state not found: {failure}"}}
         return model, None
+    state = full.space.expand(equilibrium.q)
     stiffness, held = model.operators.stiffness, model.at_rest().constraints
     missed = missed_share(model.space.phi, stiffness, held, state)
     guard = {**model.guard, "static_state": {"error_modes": missed, "added": missed > tolerance}}
@@ -125,7 +131,45 @@ def _with_static_state(model: DrillstringModel, tolerance: float) -> tuple[Drill
         model = model.with_vectors(state[:, None], guard)
     guard["static_state"]["error"] = missed_share(model.space.phi, stiffness, model.at_rest().constraints, state)
     model.guard = guard
-    return model, state
+    return _with_responses_at_rest(model, full, equilibrium, rest_tolerance), state
+
+
+def _with_responses_at_rest(model: DrillstringModel, full: DrillstringModel, equilibrium: StaticEquilibrium,
+                            tolerance: float) -> DrillstringModel:
+    """The model, with the responses of the string at rest to the loads that change in a run added to its basis
+    where it misses more than ``tolerance`` of them (in the energy norm of the tangent at rest): a unit bit
+    force and torque, and the wall's axial friction and friction torque driven by the full order's reaction at
+    rest.  The tangent holds the wall's springs and the geometric stiffness, so these are the shapes the
+    resting string takes as the bit load and the friction vary: the moment's kink at the touchdown where a
+    pinned string sags onto the wall, which the modes of the free string carry poorly (the peak stress was
+    0.6-2 % low; docs/verification.md).  Each one's share missed by the basis is in the guard (``*_at_rest``)."""
+    at_rest, space = full.at_rest(), full.space
+    zero = np.zeros(full.size)
+    evaluation = at_rest.evaluate(equilibrium.q, zero, zero, equilibrium.mu, tangent_coefficients=(1.0, 0.0, 0.0))
+    loads = bit_loads(model.disc) if model.force("bit_rock") is not None else {}
+    wall = evaluation.forces.get("wall")
+    if wall is not None and model.scene.contact.friction > 0 and wall.delta.max(initial=0.0) > 0:
+        loads.update(wall_friction_loads(model.disc, space.expand(wall.generalised)))
+    if not loads:
+        return model
+    responses = {name: response for name, response in
+                 tangent_responses(space, evaluation.tangent, at_rest.constraints, loads).items()
+                 if np.all(np.isfinite(response))}  # a singular tangent at rest gives none
+    loads = {name: loads[name] for name in responses}
+
+    def missed(basis, name):
+        return basis_error(basis.space.phi[space.free], evaluation.tangent, basis.at_rest().constraints,
+                           space.project(loads[name]), space.project(responses[name]))
+
+    report = {f"{name}_at_rest": {"error_modes": missed(model, name)} for name in loads}
+    added = [name for name in loads if report[f"{name}_at_rest"]["error_modes"] > tolerance]
+    guard = {**model.guard, **report}
+    if added:
+        model = model.with_vectors(np.column_stack([responses[name] for name in added]), guard)
+    for name in loads:
+        report[f"{name}_at_rest"].update(added=name in added, error=missed(model, name))
+    model.guard = guard
+    return model
 
 
 class RealisationRecorder:
