@@ -262,7 +262,8 @@ class Reduction:
                                  "states [-]", lambda x: 0 < x < 1, "in (0, 1)")
     hyper_training: float = _pos("simulated time of the training run of the element sample [s]", 0.1)
     out_of_band_damping: float = key(0.1, "modal damping ratio given to the directions a modal basis spans above "
-                                     "2 f_max (the stuck-bit modes and the guard's vectors combine into a light, "
+                                     "2 f_max, with the wall's springs at rest (the stuck-bit modes and the guard's "
+                                     "vectors combine into a light, "
                                      "stiff twist of the bit, which rang against the bit law's falling torque; "
                                      "0.1 stops it, 1 moved some efficiencies by 0.6-0.9 %: "
                                      "fenics_drill/model/out_of_band_damping.py); 0: none [-]",

@@ -70,8 +70,7 @@ class DrillstringModel:
         self.internal = internal_force(disc, space, operators, scene.model)
         self.forces = build_forces(scene, disc, space, operators)
         if not space.sparse:  # a modal basis: its directions above the band damped (out_of_band_damping.py)
-            damping = OutOfBandDamping.of_basis(self.mass, space.project_matrix(operators.stiffness),
-                                                band_frequency(scene), scene.reduction.out_of_band_damping)
+            damping = self._out_of_band_damping(space.project_matrix(operators.stiffness))
             if damping is not None:
                 self.forces.append(damping)
         self.drive = TopDrive.from_scene(scene, disc, space)
@@ -92,6 +91,37 @@ class DrillstringModel:
     @property
     def size(self) -> int:
         return self.space.size
+
+    def _out_of_band_damping(self, stiffness: np.ndarray) -> OutOfBandDamping | None:
+        """The damping of the Ritz directions of (``stiffness``, M_r) above the band (out_of_band_damping.py)."""
+        return OutOfBandDamping.of_basis(self.mass, stiffness, band_frequency(self.scene),
+                                         self.scene.reduction.out_of_band_damping)
+
+    def resting_stiffness(self, q: np.ndarray) -> np.ndarray | None:
+        """K_r plus the reduced wall's springs at q (the c_u = 1 tangent of the wall at rest); None without a modal
+        basis or without a vertex on the wall at q."""
+        wall = self.force("wall")
+        if self.space.sparse or wall is None:
+            return None
+        wall = wall.fresh()  # its kept tangent is the run's, not this one's
+        springs = wall.tangent(wall.evaluate(q, np.zeros_like(q), with_tangent=True), 1.0, 0.0)
+        return None if springs is None else self.space.project_matrix(self.operators.stiffness) - springs
+
+    def resting_at(self, q: np.ndarray) -> "DrillstringModel":
+        """The modal model whose damped directions above the band are those of the string resting at q: the
+        Ritz directions of :meth:`resting_stiffness`.  On the wall the springs stiffen the directions that press
+        the resting vertices into it far above f_max, and these rang against the contact where the full order's
+        local contact dynamics is damped by Newmark's alpha (a thin pipe between stabilisers lifted off and
+        bounced; docs/verification.md, "Stabilisers").  The model itself if :meth:`resting_stiffness` is None."""
+        stiffness = self.resting_stiffness(q)
+        if stiffness is None:
+            return self
+        model = copy.copy(self)
+        damping = self._out_of_band_damping(stiffness)
+        model.forces = [f for f in self.forces if f.name != OutOfBandDamping.name]
+        if damping is not None:
+            model.forces.append(damping)
+        return model
 
     def force(self, name: str):
         """The point force called ``name`` (``gravity``, ``wall``, ``bit_rock``), or None if off."""

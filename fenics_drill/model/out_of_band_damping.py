@@ -18,6 +18,12 @@ stopped it too but moved the 1 s efficiency of two short strings that did not ri
 order, against 0.1-0.2 % at 0.1.  It leaves every motion in the span of the Ritz directions below the cut
 untouched, the rigid spin and feed among them, so the band's dynamics and the drive's work are what they were;
 the energy budget books its work under ``out_of_band``.
+
+A string resting on the wall has more of them: the wall's springs (k_FS1 = 1e10 N/m, about 10 nm of indentation
+under the weight) stiffen the directions that press the resting vertices into it far above the band, where they
+rang against the contact (a thin pipe between stabilisers lifted off the wall and bounced).
+:meth:`~fenics_drill.model.drillstring.DrillstringModel.resting_at` gives the model whose damped directions are
+those of the reduced stiffness with the wall's springs at its static state.
 """
 
 from __future__ import annotations

@@ -50,6 +50,8 @@ def prepare(scene, dynamics: bool = True) -> PreparedScene:
     (a heavy string on the wall, a long one sagging far: large deflections that the modes and their
     companions carry only approximately) gets that state, solved once in the full order, as one more
     basis vector when ``reduction.enrich`` is on; the guard's report says so (``static_state``).
+    The basis's directions above the band are damped as they are with the string resting at that equilibrium
+    (:meth:`~fenics_drill.model.drillstring.DrillstringModel.resting_at`).
     With ``dynamics`` and ``reduction.hyper``, a modal model's nonlinear forces are then sampled
     (:func:`_with_element_sample`)."""
     clock = time.perf_counter()
@@ -62,6 +64,7 @@ def prepare(scene, dynamics: bool = True) -> PreparedScene:
             initial = model.space.phi.T @ (model.operators.mass @ state)  # M-orthonormal basis: the projection
     setup = time.perf_counter() - clock
     equilibrium = solve_static(model, initial=initial)
+    model = model.resting_at(equilibrium.q)
     static = {k: v for k, v in static_report(model, equilibrium).items() if k != "contact_vertices"}
     if dynamics and scene.reduction.hyper and isinstance(model.space, ModalSpace) \
             and isinstance(model.internal, AssembledInternalForce):
