@@ -189,6 +189,8 @@ class Solver:
     newton_max_iterations: int = key(25, "Newton iterations before the step is cut [-]", _positive, ">= 1")
     tangent_reuse: int = key(20, "steps over which the assembled internal tangent is reused; 1: fresh at "
                              "every step (contact and bit tangents are always fresh) [-]", _positive, ">= 1")
+    compiled_step: bool = key(True, "take a modal model's Newmark steps that keep their tangent in one compiled "
+                              "call (the same Newton, solvers/compiled_step.py); false: every step in Python")
 
 
 @dataclass(frozen=True)

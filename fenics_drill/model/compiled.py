@@ -33,7 +33,8 @@ REASSOCIATE = frozenset({"reassoc", "contract"})
 
 def kernel(function=None, *, fastmath=False):
     """``function`` compiled by Numba (nopython, cached), called so that an interrupt is not a failure;
-    ``fastmath``: Numba's flags (e.g. :data:`REASSOCIATE`)."""
+    ``fastmath``: Numba's flags (e.g. :data:`REASSOCIATE`).  The compiled function itself is the wrapper's
+    ``compiled``: what another kernel calls."""
     if function is None:
         return functools.partial(kernel, fastmath=fastmath)
     compiled = njit(cache=True, fastmath=set(fastmath) if fastmath else False)(function)
@@ -47,4 +48,5 @@ def kernel(function=None, *, fastmath=False):
                 raise
             raise KeyboardInterrupt from error
 
+    call.compiled = compiled
     return call

@@ -267,8 +267,21 @@ class DrillstringModel:
             parts = internal_parts
             if parts is None or any(part is None for part in parts):
                 parts = self._completed_parts(tangent_coefficients, parts)
-            out.internal_parts = parts if all(p is not None for p in parts) else None  # reusable only if whole
-            out.tangent_of = lambda: self._tangent(tangent_coefficients, parts, evaluations, drive)
+            self._with_tangent(out, tangent_coefficients, parts)
+        return out
+
+    def _with_tangent(self, evaluation: Evaluation, coefficients, parts) -> None:
+        """Give ``evaluation`` its tangent with ``coefficients`` (formed on first use) and the internal ``parts``."""
+        evaluation.internal_parts = parts if all(p is not None for p in parts) else None  # reusable only if whole
+        forces, drive = evaluation.forces, evaluation.drive
+        evaluation.tangent_of = lambda: self._tangent(coefficients, parts, forces, drive)
+
+    def evaluation_at(self, q, qd, residual, internal, external, evaluations: dict, coefficients,
+                      internal_parts) -> Evaluation:
+        """The :meth:`evaluate` of (q, qd) with its tangent, from a residual and force evaluations computed
+        elsewhere (:mod:`fenics_drill.model.compiled_residual`); ``internal_parts`` whole."""
+        out = Evaluation(residual, internal, external, evaluations, self.drive.evaluate(q, qd))
+        self._with_tangent(out, coefficients, internal_parts)
         return out
 
     def _completed_parts(self, coefficients, kept) -> tuple:

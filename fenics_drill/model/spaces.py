@@ -128,6 +128,32 @@ def column_bound(rows) -> np.ndarray:
     return bound.toarray().ravel() if sp.issparse(bound) else np.asarray(bound).ravel()
 
 
+class SaddleLU:
+    """[[J, k B^T], [k B, 0]] of (76) factorised by LAPACK's getrf, solved by getrs, both called directly: SciPy's
+    lu_factor/lu_solve check and look up LAPACK at every call, which costs ten times the solve of a small system
+    (a Newton iterate makes several).  k = :func:`constraint_scale`; ``factors`` (Fortran order), ``pivots``
+    (0-based, as SciPy gives them) and ``scale`` are what a compiled solve reads (solvers/compiled_step.py)."""
+
+    def __init__(self, tangent: np.ndarray, constraints: np.ndarray):
+        n, m = tangent.shape[0], constraints.shape[0]
+        k = constraint_scale(tangent, constraints)
+        system = np.empty((n + m, n + m), order="F")  # LAPACK's order: factorised in place, no copy
+        system[:n, :n], system[:n, n:] = tangent, k * constraints.T
+        system[n:, :n], system[n:, n:] = k * constraints, 0.0
+        factors, pivots, info = getrf(system, overwrite_a=True)
+        if info < 0:
+            raise ValueError(f"getrf: argument {-info} is invalid")
+        # info > 0: an exactly singular system; the solve gives non-finite values, which Newton reports
+        self.factors, self.pivots, self.scale, self.size = factors, pivots, k, n
+        self._rhs = np.empty(n + m)
+
+    def __call__(self, rhs_q: np.ndarray, rhs_c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        n, rhs = self.size, self._rhs
+        rhs[:n], rhs[n:] = rhs_q, self.scale * rhs_c
+        x, _ = getrs(self.factors, self.pivots, rhs)
+        return x[:n], self.scale * x[n:]
+
+
 class ModalSpace:
     """Dense modal basis [Phi] (N_dofs x N_red)."""
 
@@ -135,7 +161,7 @@ class ModalSpace:
 
     def __init__(self, phi: np.ndarray):
         self.phi = np.ascontiguousarray(phi)
-        self._saddle = SaddleFactorisation(self._factorise)
+        self._saddle = SaddleFactorisation(SaddleLU)
 
     @property
     def size(self) -> int:
@@ -188,27 +214,9 @@ class ModalSpace:
                 out += c * matrix
         return np.zeros((self.size, self.size)) if out is None else out
 
-    @staticmethod
-    def _factorise(tangent: np.ndarray, constraints: np.ndarray):
-        """LAPACK's getrf/getrs called directly: SciPy's lu_factor/lu_solve check and look up LAPACK at every
-        call, which costs ten times the solve of a small system (a Newton iterate makes several)."""
-        n, m = tangent.shape[0], constraints.shape[0]
-        k = constraint_scale(tangent, constraints)
-        system = np.empty((n + m, n + m), order="F")  # LAPACK's order: factorised in place, no copy
-        system[:n, :n], system[:n, n:] = tangent, k * constraints.T
-        system[n:, :n], system[n:, n:] = k * constraints, 0.0
-        factors, pivots, info = getrf(system, overwrite_a=True)
-        if info < 0:
-            raise ValueError(f"getrf: argument {-info} is invalid")
-        # info > 0: an exactly singular system; the solve gives non-finite values, which Newton reports
-        rhs = np.empty(n + m)
-
-        def solve(rhs_q, rhs_c):
-            rhs[:n], rhs[n:] = rhs_q, k * rhs_c
-            x, _ = getrs(factors, pivots, rhs)
-            return x[:n], k * x[n:]
-
-        return solve
+    def factorised(self, tangent: np.ndarray, constraints: np.ndarray) -> "SaddleLU":
+        """The LU of the saddle matrix of (76) for (tangent, constraints), kept as :meth:`saddle_solve` keeps it."""
+        return self._saddle(tangent, constraints)
 
     def saddle_solve(self, tangent: np.ndarray, constraints: np.ndarray, rhs_q: np.ndarray, rhs_c: np.ndarray):
         """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76) (LU kept for the same J and B)."""

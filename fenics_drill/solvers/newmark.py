@@ -14,9 +14,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fenics_drill.model.compiled_residual import CompiledResidual
 from fenics_drill.model.drillstring import DrillstringModel, Evaluation
 from fenics_drill.model.spaces import column_bound
-from fenics_drill.solvers.newton import KeptTangent, saddle_newton
+from fenics_drill.solvers.compiled_step import kept_tangent_step
+from fenics_drill.solvers.newton import ARMIJO, KeptTangent, saddle_newton
 
 
 #: A Newton iterate keeps the tangent of the previous one while the residual shrinks at least this much
@@ -91,13 +93,13 @@ class NewmarkNewton:
     """One Newmark step of (65) with the constraints (72) enforced by multipliers."""
 
     def __init__(self, model: DrillstringModel, alpha: float, tolerance: float, max_iterations: int,
-                 tangent_reuse: int = 20, settle_length: float | None = None):
+                 tangent_reuse: int = 20, settle_length: float | None = None, compiled: bool = True):
         """``tangent_reuse``: steps over which an assembled internal tangent is kept (the displacements
         are small, so it changes slowly; contact and bit-rock tangents are fresh at every iteration).
         ``settle_length`` [m]: Newton also stops at an iterate whose next update would move no point of the
         string's surface by more than SETTLED_SHARE (SETTLED_SHARE_FULL in the full space) of it (the step's
-        error tolerance); None: on its residual
-        alone."""
+        error tolerance); None: on its residual alone.  ``compiled``: the steps that keep their tangent are
+        taken by :func:`~fenics_drill.solvers.compiled_step.kept_tangent_step` where the model allows it."""
         self.model = model
         self.tangent_reuse = tangent_reuse
         self.gamma, self.beta = newmark_parameters(alpha)
@@ -112,11 +114,15 @@ class NewmarkNewton:
         self._motion_bound = column_bound(model.motion_rows)
         self._carried = KeptTangent()  # the last step's tangent, for the next step of the same size
         self._carried_dt = None
+        self.compiled = compiled
+        self._compiled = CompiledResidual.of(model) if compiled else None
+        self.compiled_steps = 0  # steps taken by the compiled step
 
     def forget_tangent(self) -> None:
         """Assemble the internal tangent afresh at the next step (the internal force has changed)."""
         self._internal_parts = None
         self._carried.matrix = None
+        self._compiled = CompiledResidual.of(self.model) if self.compiled else None
 
     def constraint_target(self, t: float, h0: np.ndarray) -> np.ndarray:
         """h(t) of (71) for the rows the basis leaves: u(0, t) = V0 t, theta_x(0, t) = Omega t."""
@@ -152,6 +158,9 @@ class NewmarkNewton:
         on the residual norm: the bit-rock law (20) has a kink at u_dot_bit = 0 and the wall law (17)
         one at first contact, where plain Newton can cycle between the two branches.
         """
+        taken = self._compiled_step(state, dt, h0)
+        if taken is not None:
+            return taken
         g, b = self.gamma, self.beta
         q_pred = state.q + dt * state.qd + dt * dt * (0.5 - b) * state.qdd
         qd_pred = state.qd + dt * (1.0 - g) * state.qdd
@@ -246,3 +255,39 @@ class NewmarkNewton:
         if result is None:
             raise NewtonFailure(f"Newton did not converge in {self.max_iterations} iterations at dt = {dt:.3e} s")
         return result
+
+    def _compiled_step(self, state: State, dt: float, h0: np.ndarray) -> tuple[State, int, Evaluation] | None:
+        """The step as :meth:`step` takes it, by :func:`~fenics_drill.solvers.compiled_step.kept_tangent_step`,
+        when it starts with the last step's tangent and its internal parts are not due to be assembled; None
+        when it does not, or when the compiled step hands it back (then :meth:`step` takes it from its start)."""
+        if (self._compiled is None or self._carried.matrix is None or dt != self._carried_dt
+                or self._internal_parts is None or self._steps_since_tangent >= self.tangent_reuse):
+            return None
+        forces = self._compiled.forces()
+        if forces is None:
+            return None
+        model = self.model
+        lu = model.space.factorised(self._carried.matrix, model.constraints)
+        multipliers = np.broadcast_to(self._multiplier_level, (model.constraints.shape[0],)).astype(float)
+        settle = -1.0 if self.settle_length is None else self.settle_length
+        rates = (TANGENT_REUSE_RATE, SLOW_CONTRACTION, SETTLED_CONTRACTION, SETTLED_FORCE_SHARE, ROUND_OFF, ARMIJO,
+                 self.tolerance)
+        taken, q, qd, qdd, mu, iterations, ev, force_level, multipliers, kept = kept_tangent_step(
+            self._compiled.internal, forces, self._compiled.order, model.constraints,
+            (lu.factors, lu.pivots, lu.scale), model.mass, model.motion_rows, self._motion_bound, state.q, state.qd,
+            state.qdd, state.mu, dt, (self.gamma, self.beta), self.constraint_target(state.t + dt, h0),
+            (self._force_level, multipliers), (settle, self.settled_share), self.max_iterations,
+            self._steps_since_stiffness > 0 and model.internal.state_dependent, rates)
+        if not taken:
+            return None
+        self._force_level, self._multiplier_level = force_level, multipliers
+        self._steps_since_tangent += 1
+        self._steps_since_stiffness += 1
+        if not kept or iterations > CARRY_WITHIN:
+            self._carried.matrix = None
+        self.compiled_steps += 1
+        residual, internal, external, wall, _, _ = ev
+        coefficients = (1.0, self.gamma / (self.beta * dt), 1.0 / (self.beta * dt * dt))
+        evaluation = model.evaluation_at(q, qd, residual, internal, external, self._compiled.evaluations(q, qd, wall),
+                                         coefficients, self._internal_parts)
+        return State(state.t + dt, q, qd, qdd, mu), iterations, evaluation

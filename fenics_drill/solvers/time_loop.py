@@ -48,7 +48,8 @@ class Simulation:
         self.model, self.scene = model, scene
         solver = scene.solver
         self.stepper = NewmarkNewton(model, scene.time.newmark_alpha, solver.newton_tolerance,
-                                     solver.newton_max_iterations, solver.tangent_reuse, scene.time.error_tolerance)
+                                     solver.newton_max_iterations, solver.tangent_reuse, scene.time.error_tolerance,
+                                     solver.compiled_step)
         self.controller = StepController(scene, self.stepper.beta, model.error_rows)
         self.impacts = ImpactCounter(len(model.disc.vertex_x), model.gap)
         self.stats = {"steps": 0, "rejected_steps": 0, "newton_failures": 0, "newton_iterations": 0,

@@ -505,11 +505,22 @@ class WallContact:
         else:
             delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(vertex_set.flat, q, qd,
                                                                                      *self._law())
+        return self.forces_of(vertex_set, (delta, nodal, laws, potential, generalised, lateral, rates), with_tangent)
+
+    def forces_of(self, vertex_set: VertexSet, passed: tuple, with_tangent: bool) -> WallForces:
+        """The evaluation of the vertices ``vertex_set`` from what :func:`_modal_pass` gives for them (also what a
+        compiled Newton step hands back: solvers/compiled_step.py)."""
+        delta, nodal, laws, potential, generalised, lateral, rates = passed
         by_law = ProjectedLaws(vertex_set.flat, delta, laws)
         out = WallForces(generalised, potential, by_law, len(self.x), vertex_set.vertices, delta, nodal)
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
             out.tangent_data = (vertex_set.flat, lateral, rates)
         return out
+
+    def evaluated_vertices(self) -> VertexSet:
+        """The vertices the next modal evaluation starts from: the culled set of the last one (None before any),
+        or all of them without culling; each evaluation checks the culled set's bound itself."""
+        return self._near if self.culling else self.every
 
     def tangent(self, forces: WallForces, c_u: float, c_v: float):
         """c_u d f/dq + c_v d f/dqd of the generalised wall force (None without contact):

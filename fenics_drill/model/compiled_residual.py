@@ -1,0 +1,140 @@
+"""The residual (65) of a modal model with the usual forces, in one compiled call.
+
+:meth:`DrillstringModel.evaluate` runs each force's kernel from Python and sums their loads there; at the
+paper scene's two evaluations per step that glue costs about as much as the kernels (benchmarks/RESULTS.md,
+items 76-77).  :func:`residual_at` runs the same kernels (the sampled internal force of
+:mod:`~fenics_drill.model.cell_kernels`, the wall's :func:`~fenics_drill.model.forces.wall_contact._modal_pass`,
+the bit law (20)-(22)) and the same sums, in the same order, for the compiled Newton step of
+:mod:`fenics_drill.solvers.compiled_step`.
+
+It covers a modal model whose drive holds both top dofs, whose string has no top-drive inertia, and whose point
+forces are gravity, the wall, the paper's bit-rock law and the damping above the band
+(:func:`CompiledResidual.of` returns None for any other model, which then runs in Python).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from fenics_drill.model.cell_kernels import _assemble_cells_at
+from fenics_drill.model.forces.bit_rock import BitRock, _law
+from fenics_drill.model.forces.gravity import Gravity
+from fenics_drill.model.forces.wall_contact import WallContact, _modal_pass
+from fenics_drill.model.internal_force import AssembledInternalForce
+from fenics_drill.model.out_of_band_damping import OutOfBandDamping
+
+#: The kinds of point force :func:`residual_at` sums, in the order of the model's list.
+GRAVITY, WALL, BIT_ROCK, DAMPING = 0, 1, 2, 3
+_KINDS = {Gravity: GRAVITY, WallContact: WALL, BitRock: BIT_ROCK, OutOfBandDamping: DAMPING}
+
+_ASSEMBLE_CELLS_AT, _WALL_PASS, _BIT_LAW = _assemble_cells_at.compiled, _modal_pass.compiled, _law.compiled
+
+
+@njit(cache=True)
+def _internal_force(internal, q, qd, qdd):
+    """:meth:`AssembledInternalForce.evaluate` of a modal space: [K C M] (q, qd, qdd) plus the sampled
+    remainder (a sample), or the cells' force alone (all cells)."""
+    sampled, linear_rows, offset, rows, row_function, row_dof, basis, address, constants, coordinates, cell_dofs, \
+        size = internal
+    state = np.concatenate((q, qd, qdd))
+    cells = _ASSEMBLE_CELLS_AT(address, offset, rows, row_function, row_dof, state, constants, coordinates,
+                               cell_dofs, size, False, basis, True)
+    if not sampled:
+        return cells
+    return np.dot(linear_rows, state) + cells
+
+
+@njit(cache=True)
+def residual_at(internal, forces, order, constraints, q, qd, qdd, mu):
+    """The residual, internal and external forces of :meth:`DrillstringModel.evaluate` at (q, qd, qdd, mu), with
+    what the wall's pass and the bit law gave (for the step's evaluation object), and whether q is still within
+    the bound of the wall's culled vertices (False: the evaluation is not the model's, which would cull anew).
+
+    ``forces``: (gravity load, wall rows, wall law, culling bound, reference q, reach, bit rows, bit unit loads,
+    bit law constants, damping matrix); ``order``: the kinds of the model's forces in its order."""
+    gravity, flat, law, column_bound, q_ref, reach, bit_rows, bit_units, bit_law, damping = forces
+    internal_force = _internal_force(internal, q, qd, qdd)
+    external = np.zeros(q.size)
+    within = True
+    wall = (np.empty(0), np.empty((0, 4)), np.empty((0, 4, 3)), 0.0, np.empty(0), np.empty((0, 2)),
+            np.empty((0, 4)))
+    bit = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    for kind in order:
+        if kind == GRAVITY:
+            external += gravity
+        elif kind == WALL:
+            within = np.dot(column_bound, np.abs(q - q_ref)) < reach
+            wall = _WALL_PASS(flat, q, qd, law[0], law[1], law[2], law[3], law[4], law[5], law[6], law[7], law[8])
+            external += wall[4]
+        elif kind == BIT_ROCK:
+            rates = np.dot(bit_rows, qd)
+            force, torque, d_force, d_torque_velocity, d_torque_spin = _BIT_LAW(
+                rates[0], rates[1], bit_law[0], bit_law[1], bit_law[2], bit_law[3])
+            external += force * bit_units[0] + torque * bit_units[1]
+            bit = (rates[0], rates[1], force, torque, d_force, d_torque_velocity, d_torque_spin)
+        else:
+            external += -np.dot(damping, qd)
+    residual = internal_force - external
+    if mu.size:
+        residual += np.dot(constraints.T, mu)
+    return residual, internal_force, external, wall, bit, within
+
+
+class CompiledResidual:
+    """What :func:`residual_at` needs of one model: its internal force's cells and the forces' data."""
+
+    def __init__(self, model, internal: tuple, order: np.ndarray):
+        self.model, self.internal, self.order = model, internal, order
+        self.wall = model.force(WallContact.name)
+
+    @classmethod
+    def of(cls, model) -> "CompiledResidual | None":
+        """The compiled residual of ``model``, or None where it does not cover the model (module doc)."""
+        force = model.internal
+        if (model.space.sparse or model.drive.inertia or not model.drive.held.all()
+                or not isinstance(force, AssembledInternalForce)
+                or any(type(f) not in _KINDS for f in model.forces)
+                or len({type(f) for f in model.forces}) != len(model.forces)):
+            return None
+        packing = force._packing
+        cells = packing.cells
+        sampled = force.sample is not None
+        internal = (sampled, force._linear_rows if sampled else np.empty((0, 0)), packing.offset, packing.rows,
+                    packing.row_function, packing.row_dof, packing.basis, cells.address, cells.constants,
+                    cells.coordinates, cells.cell_dofs, cells.size)
+        order = np.array([_KINDS[type(f)] for f in model.forces], dtype=np.int64)
+        return cls(model, internal, order)
+
+    def forces(self):
+        """The forces' data of :func:`residual_at` now (the wall's culled vertices are the last evaluation's),
+        or None if the wall has culled none yet."""
+        size = self.model.size
+        gravity, bit, damping = (self.model.force(name) for name in (Gravity.name, BitRock.name,
+                                                                    OutOfBandDamping.name))
+        flat, law, bound, q_ref, reach = np.empty((0, size)), (0.0,) * 4 + (False,) + (0.0,) * 4, \
+            np.zeros(size), np.zeros(size), np.inf
+        if self.wall is not None:
+            vertices = self.wall.evaluated_vertices()
+            if vertices is None:
+                return None
+            flat, law = vertices.flat, self.wall._law()
+            if vertices.q_ref is not None:
+                bound, q_ref, reach = vertices.column_bound, vertices.q_ref, vertices.reach
+        return (np.zeros(size) if gravity is None else gravity.load, flat,
+                tuple(float(v) if not isinstance(v, bool) else v for v in law), bound, q_ref, float(reach),
+                np.empty((2, size)) if bit is None else bit.rows.dense(),
+                np.empty((2, size)) if bit is None else np.array(bit._unit_loads),
+                (0.0,) * 4 if bit is None else (bit.limit_force, bit.rate, bit.friction, bit.borehole_radius),
+                np.empty((0, size)) if damping is None else damping.damping)
+
+    def evaluations(self, q, qd, wall_passed) -> dict:
+        """The forces' evaluation objects at an accepted (q, qd), each as its own ``evaluate`` gives it (the wall's
+        from what the compiled pass gave)."""
+        out = {}
+        for force in self.model.forces:
+            if force is self.wall:
+                out[force.name] = force.forces_of(force.evaluated_vertices(), wall_passed, True)
+            else:
+                out[force.name] = force.evaluate(q, qd, with_tangent=True)
+        return out
