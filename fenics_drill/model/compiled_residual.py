@@ -87,6 +87,7 @@ class CompiledResidual:
     def __init__(self, model, internal: tuple, order: np.ndarray):
         self.model, self.internal, self.order = model, internal, order
         self.wall = model.force(WallContact.name)
+        self._forces = (None, None)  # (the wall's vertex set, the forces' data for it) last given
 
     @classmethod
     def of(cls, model) -> "CompiledResidual | None":
@@ -108,7 +109,13 @@ class CompiledResidual:
 
     def forces(self):
         """The forces' data of :func:`residual_at` now (the wall's culled vertices are the last evaluation's),
-        or None if the wall has culled none yet."""
+        or None if the wall has culled none yet; formed again only when the wall's vertex set has changed."""
+        vertices = self.wall.evaluated_vertices() if self.wall is not None else None
+        if self._forces[1] is None or vertices is not self._forces[0]:
+            self._forces = (vertices, self._formed_forces())
+        return self._forces[1]
+
+    def _formed_forces(self):
         size = self.model.size
         gravity, bit, damping = (self.model.force(name) for name in (Gravity.name, BitRock.name,
                                                                     OutOfBandDamping.name))

@@ -108,7 +108,7 @@ class NewmarkNewton:
         # accepted steps since all parts of the internal tangent, and since its df/dq, were assembled
         self._steps_since_tangent = self._steps_since_stiffness = 0
         self._force_level = 0.0
-        self._multiplier_level = 0.0  # the largest |mu_i| of the accepted steps
+        self._multiplier_level = np.zeros(model.constraints.shape[0])  # the largest |mu_i| of the accepted steps
         self.settle_length = settle_length
         self.settled_share = SETTLED_SHARE_FULL if model.space.sparse else SETTLED_SHARE
         self._motion_bound = column_bound(model.motion_rows)
@@ -246,6 +246,14 @@ class NewmarkNewton:
         if stale or dt != self._carried_dt:  # another system: the carried tangent does not describe it
             self._carried.matrix = None
         self._carried_dt = dt
+        if self._carried.matrix is None and self._compiled is not None:
+            # the tangent Newton takes at its first update, formed now: the rest of the step is the compiled one
+            self._carried.matrix = ev.tangent
+            taken = self._compiled_step(state, dt, h0)
+            if taken is not None:
+                if taken[1] == 1:  # converged at the predictor: this Newton forms no tangent, and carries none
+                    self._carried.matrix = None
+                return taken
         result = saddle_newton(trial, self.model.space, self.model.constraints, target,
                                q, mu, ev, check, self.max_iterations, reuse_rate=TANGENT_REUSE_RATE,
                                kink_step=lambda ev, dq: self.model.kink_step(ev, dq, c_v), settled=settled,
@@ -258,8 +266,9 @@ class NewmarkNewton:
 
     def _compiled_step(self, state: State, dt: float, h0: np.ndarray) -> tuple[State, int, Evaluation] | None:
         """The step as :meth:`step` takes it, by :func:`~fenics_drill.solvers.compiled_step.kept_tangent_step`,
-        when it starts with the last step's tangent and its internal parts are not due to be assembled; None
-        when it does not, or when the compiled step hands it back (then :meth:`step` takes it from its start)."""
+        when it starts with a tangent kept for it (the last step's, or the one :meth:`step` formed at its
+        predictor) and its internal parts are not due to be assembled; None when it does not, or when the
+        compiled step hands it back (then :meth:`step` takes it in Python)."""
         if (self._compiled is None or self._carried.matrix is None or dt != self._carried_dt
                 or self._internal_parts is None or self._steps_since_tangent >= self.tangent_reuse):
             return None
@@ -268,7 +277,6 @@ class NewmarkNewton:
             return None
         model = self.model
         lu = model.space.factorised(self._carried.matrix, model.constraints)
-        multipliers = np.broadcast_to(self._multiplier_level, (model.constraints.shape[0],)).astype(float)
         settle = -1.0 if self.settle_length is None else self.settle_length
         rates = (TANGENT_REUSE_RATE, SLOW_CONTRACTION, SETTLED_CONTRACTION, SETTLED_FORCE_SHARE, ROUND_OFF, ARMIJO,
                  self.tolerance)
@@ -276,7 +284,7 @@ class NewmarkNewton:
             self._compiled.internal, forces, self._compiled.order, model.constraints,
             (lu.factors, lu.pivots, lu.scale), model.mass, model.motion_rows, self._motion_bound, state.q, state.qd,
             state.qdd, state.mu, dt, (self.gamma, self.beta), self.constraint_target(state.t + dt, h0),
-            (self._force_level, multipliers), (settle, self.settled_share), self.max_iterations,
+            (self._force_level, self._multiplier_level), (settle, self.settled_share), self.max_iterations,
             self._steps_since_stiffness > 0 and model.internal.state_dependent, rates)
         if not taken:
             return None
