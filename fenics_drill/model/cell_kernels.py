@@ -135,6 +135,10 @@ def _assemble_cells_at(address, offset, rows, row_function, row_dof, state, cons
     return out
 
 
+#: :func:`_assemble_cells_at` itself, for compiled code that assembles a force (model/compiled_residual.py).
+ASSEMBLE_CELLS_AT = _assemble_cells_at.compiled
+
+
 @kernel(fastmath=REASSOCIATE)
 def _functionals_at(address, offset, rows, row_function, row_dof, states, constants, coordinates, cell_dofs, basis):
     """A functional (a form of rank 0) at each row of ``states``, as :func:`_assemble_cells_at` gives it for one:

@@ -7,6 +7,11 @@ called, Numba reports that exception as a SystemError chained to it, and the run
 function (cached on disk, so a process pays the compilation once per install) and calls it through a
 wrapper that raises the interrupt as what it is.  Kernels called only from other kernels need
 ``numba.njit(cache=True)`` alone: the wrapper is for the ones Python calls.
+
+Numba keeps a kernel's compiled code on disk (``__pycache__``) until its own file changes, not when a kernel it
+calls from another file does: after editing a kernel that kernels of other files call (the laws and passes that
+``model/compiled_residual.py`` and ``solvers/compiled_step.py`` call, ``cell_kernels.tabulate_at_cells``), touch
+those files or delete their ``__pycache__`` directories, or they run the old code.
 """
 
 from __future__ import annotations

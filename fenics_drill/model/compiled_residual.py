@@ -17,19 +17,18 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from fenics_drill.model.cell_kernels import _assemble_cells_at
-from fenics_drill.model.forces.bit_rock import BitRock, _law
+from fenics_drill.model.cell_kernels import ASSEMBLE_CELLS_AT
+from fenics_drill.model.forces.bit_rock import LAW as BIT_LAW
+from fenics_drill.model.forces.bit_rock import BitRock
 from fenics_drill.model.forces.gravity import Gravity
-from fenics_drill.model.forces.wall_contact import WallContact, _modal_pass
+from fenics_drill.model.forces.wall_contact import MODAL_PASS as WALL_PASS
+from fenics_drill.model.forces.wall_contact import WallContact
 from fenics_drill.model.internal_force import AssembledInternalForce
 from fenics_drill.model.out_of_band_damping import OutOfBandDamping
 
 #: The kinds of point force :func:`residual_at` sums, in the order of the model's list.
 GRAVITY, WALL, BIT_ROCK, DAMPING = 0, 1, 2, 3
 _KINDS = {Gravity: GRAVITY, WallContact: WALL, BitRock: BIT_ROCK, OutOfBandDamping: DAMPING}
-
-_ASSEMBLE_CELLS_AT, _WALL_PASS, _BIT_LAW = _assemble_cells_at.compiled, _modal_pass.compiled, _law.compiled
-
 
 @njit(cache=True)
 def _internal_force(internal, q, qd, qdd):
@@ -38,7 +37,7 @@ def _internal_force(internal, q, qd, qdd):
     sampled, linear_rows, offset, rows, row_function, row_dof, basis, address, constants, coordinates, cell_dofs, \
         size = internal
     state = np.concatenate((q, qd, qdd))
-    cells = _ASSEMBLE_CELLS_AT(address, offset, rows, row_function, row_dof, state, constants, coordinates,
+    cells = ASSEMBLE_CELLS_AT(address, offset, rows, row_function, row_dof, state, constants, coordinates,
                                cell_dofs, size, False, basis, True)
     if not sampled:
         return cells
@@ -65,11 +64,11 @@ def residual_at(internal, forces, order, constraints, q, qd, qdd, mu):
             external += gravity
         elif kind == WALL:
             within = np.dot(column_bound, np.abs(q - q_ref)) < reach
-            wall = _WALL_PASS(flat, q, qd, law[0], law[1], law[2], law[3], law[4], law[5], law[6], law[7], law[8])
+            wall = WALL_PASS(flat, q, qd, law[0], law[1], law[2], law[3], law[4], law[5], law[6], law[7], law[8])
             external += wall[4]
         elif kind == BIT_ROCK:
             rates = np.dot(bit_rows, qd)
-            force, torque, d_force, d_torque_velocity, d_torque_spin = _BIT_LAW(
+            force, torque, d_force, d_torque_velocity, d_torque_spin = BIT_LAW(
                 rates[0], rates[1], bit_law[0], bit_law[1], bit_law[2], bit_law[3])
             external += force * bit_units[0] + torque * bit_units[1]
             bit = (rates[0], rates[1], force, torque, d_force, d_torque_velocity, d_torque_spin)
@@ -92,47 +91,31 @@ class CompiledResidual:
     @classmethod
     def of(cls, model) -> "CompiledResidual | None":
         """The compiled residual of ``model``, or None where it does not cover the model (module doc)."""
-        force = model.internal
-        if (model.space.sparse or model.drive.inertia or not model.drive.held.all()
-                or not isinstance(force, AssembledInternalForce)
+        internal = (model.internal.kernel_data() if isinstance(model.internal, AssembledInternalForce) else None)
+        if (internal is None or model.drive.inertia or not model.drive.held.all()
                 or any(type(f) not in _KINDS for f in model.forces)
                 or len({type(f) for f in model.forces}) != len(model.forces)):
             return None
-        packing = force._packing
-        cells = packing.cells
-        sampled = force.sample is not None
-        internal = (sampled, force._linear_rows if sampled else np.empty((0, 0)), packing.offset, packing.rows,
-                    packing.row_function, packing.row_dof, packing.basis, cells.address, cells.constants,
-                    cells.coordinates, cells.cell_dofs, cells.size)
-        order = np.array([_KINDS[type(f)] for f in model.forces], dtype=np.int64)
-        return cls(model, internal, order)
+        return cls(model, internal, np.array([_KINDS[type(f)] for f in model.forces], dtype=np.int64))
 
     def forces(self):
         """The forces' data of :func:`residual_at` now (the wall's culled vertices are the last evaluation's),
         or None if the wall has culled none yet; formed again only when the wall's vertex set has changed."""
         vertices = self.wall.evaluated_vertices() if self.wall is not None else None
+        if self.wall is not None and vertices is None:
+            return None
         if self._forces[1] is None or vertices is not self._forces[0]:
-            self._forces = (vertices, self._formed_forces())
+            self._forces = (vertices, self._formed_forces(vertices))
         return self._forces[1]
 
-    def _formed_forces(self):
+    def _formed_forces(self, vertices) -> tuple:
         size = self.model.size
         gravity, bit, damping = (self.model.force(name) for name in (Gravity.name, BitRock.name,
                                                                     OutOfBandDamping.name))
-        flat, law, bound, q_ref, reach = np.empty((0, size)), (0.0,) * 4 + (False,) + (0.0,) * 4, \
-            np.zeros(size), np.zeros(size), np.inf
-        if self.wall is not None:
-            vertices = self.wall.evaluated_vertices()
-            if vertices is None:
-                return None
-            flat, law = vertices.flat, self.wall._law()
-            if vertices.q_ref is not None:
-                bound, q_ref, reach = vertices.column_bound, vertices.q_ref, vertices.reach
-        return (np.zeros(size) if gravity is None else gravity.load, flat,
-                tuple(float(v) if not isinstance(v, bool) else v for v in law), bound, q_ref, float(reach),
-                np.empty((2, size)) if bit is None else bit.rows.dense(),
-                np.empty((2, size)) if bit is None else np.array(bit._unit_loads),
-                (0.0,) * 4 if bit is None else (bit.limit_force, bit.rate, bit.friction, bit.borehole_radius),
+        wall = (self.wall.kernel_data(vertices) if self.wall is not None else
+                (np.empty((0, size)), (0.0,) * 4 + (False,) + (0.0,) * 4, np.zeros(size), np.zeros(size), np.inf))
+        bit_data = bit.kernel_data() if bit is not None else (np.empty((2, size)), np.empty((2, size)), (0.0,) * 4)
+        return (np.zeros(size) if gravity is None else gravity.load, *wall, *bit_data,
                 np.empty((0, size)) if damping is None else damping.damping)
 
     def evaluations(self, q, qd, wall_passed) -> dict:

@@ -232,6 +232,19 @@ class AssembledInternalForce:
         (cells x dofs per cell): what the ECSW trainer projects element by element."""
         return self._packing.element_tensors(np.concatenate((q, qd, qdd)))
 
+    def kernel_data(self) -> tuple | None:
+        """What :func:`~fenics_drill.model.compiled_residual.residual_at` needs to evaluate this force as
+        :meth:`evaluate` does: (sampled, [K C M] or an empty matrix, the packed coefficients' placement, the
+        basis rows, and the residual kernel's address, constants, coordinates, cell dofs and size); None in
+        the full space."""
+        if self._kernel_cells is None:
+            return None
+        packing, sampled = self._packing, self.sample is not None
+        cells = packing.cells
+        return (sampled, self._linear_rows if sampled else np.empty((0, 0)), packing.offset, packing.rows,
+                packing.row_function, packing.row_dof, packing.basis, cells.address, cells.constants,
+                cells.coordinates, cells.cell_dofs, cells.size)
+
     def evaluate(self, q, qd, qdd) -> np.ndarray:
         self._state = (q, qd, qdd)
         if self._kernel_cells is None:

@@ -58,6 +58,10 @@ def _law(bit_velocity, bit_spin_rate, limit_force, rate, friction, borehole_radi
             friction * force * borehole_radius * _regularisation_slope(bit_spin_rate))
 
 
+#: :func:`_law` itself, for compiled code that evaluates the bit (model/compiled_residual.py).
+LAW = _law.compiled
+
+
 _FORCE, _TORQUE = np.vectorize(_force, otypes=(float,)), np.vectorize(_torque, otypes=(float,))
 _REGULARISATION = np.vectorize(_regularisation, otypes=(float,))
 _REGULARISATION_SLOPE = np.vectorize(_regularisation_slope, otypes=(float,))
@@ -148,6 +152,12 @@ class BitRock:
 
     def record(self, forces: "BitForces") -> dict[str, float]:
         return {"bit_force": forces.force, "bit_torque": forces.torque}
+
+    def kernel_data(self) -> tuple:
+        """(the rows of u(L), theta_x(L), their unit loads, the law's constants) for
+        :func:`~fenics_drill.model.compiled_residual.residual_at` (a modal space)."""
+        return (self.rows.dense(), np.array(self._unit_loads),
+                (self.limit_force, self.rate, self.friction, self.borehole_radius))
 
     def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> BitForces:
         u_dot, omega = self.rows.values(qd).tolist()

@@ -174,6 +174,10 @@ def _modal_pass(flat, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque,
     return delta, nodal, laws, potential, generalised, lateral, rates
 
 
+#: :func:`_modal_pass` itself, for compiled code that evaluates the wall (model/compiled_residual.py).
+MODAL_PASS = _modal_pass.compiled
+
+
 @kernel(fastmath=REASSOCIATE)
 def _projected_laws(flat, delta, laws):
     """[Phi]^T of the loads of the damper, the axial friction and the friction torque (rows of the result),
@@ -521,6 +525,16 @@ class WallContact:
         """The vertices the next modal evaluation starts from: the culled set of the last one (None before any),
         or all of them without culling; each evaluation checks the culled set's bound itself."""
         return self._near if self.culling else self.every
+
+    def kernel_data(self, vertex_set: VertexSet) -> tuple:
+        """(the dense rows of ``vertex_set``, the law's constants, and the bound that keeps it: its columns'
+        sizes, reference q and reach; none for every vertex) for
+        :func:`~fenics_drill.model.compiled_residual.residual_at`."""
+        size = vertex_set.flat.shape[1]
+        law = tuple(value if isinstance(value, bool) else float(value) for value in self._law())
+        if vertex_set.q_ref is None:
+            return vertex_set.flat, law, np.zeros(size), np.zeros(size), np.inf
+        return vertex_set.flat, law, vertex_set.column_bound, vertex_set.q_ref, float(vertex_set.reach)
 
     def tangent(self, forces: WallForces, c_u: float, c_v: float):
         """c_u d f/dq + c_v d f/dqd of the generalised wall force (None without contact):
