@@ -18,6 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
+from fenics_drill.model.compiled import kernel
 from fenics_drill.model.compiled_residual import residual_at
 
 
@@ -62,7 +63,7 @@ def _moves_less_than(motion_bound, motion_rows, dq, length):
     return np.max(np.abs(np.dot(motion_rows, dq))) <= length
 
 
-@njit(cache=True)
+@kernel
 def kept_tangent_step(internal, forces, order, constraints, lu, mass, motion_rows, motion_bound, q0, qd0, qdd0, mu0,
                       dt, newmark, target, levels, settling, max_iterations, drifted, rates):
     """One step of :meth:`NewmarkNewton.step` whose Newton keeps the LU ``lu`` = (factors, pivots, k) throughout.
