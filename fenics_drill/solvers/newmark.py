@@ -116,7 +116,7 @@ class NewmarkNewton:
         self._carried_dt = None
         self.compiled = compiled
         self._compiled = CompiledResidual.of(model) if compiled else None
-        self.compiled_steps = 0  # steps taken by the compiled step
+        self.compiled_steps = 0  # steps solved by the compiled step (the step controller may reject some)
 
     def forget_tangent(self) -> None:
         """Assemble the internal tangent afresh at the next step (the internal force has changed)."""
