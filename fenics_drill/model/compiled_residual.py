@@ -7,8 +7,8 @@ items 76-77).  :func:`residual_at` runs the same kernels (the sampled internal f
 the bit law (20)-(22)) and the same sums, in the same order, for the compiled Newton step of
 :mod:`fenics_drill.solvers.compiled_step`.
 
-It covers a modal model whose drive holds both top dofs, whose string has no top-drive inertia, and whose point
-forces are gravity, the wall, the paper's bit-rock law and the damping above the band
+It covers a modal model whose drive holds the top's rotation (and its axial motion, or pushes it with a hook
+load), and whose point forces are gravity, the wall, the paper's bit-rock law and the damping above the band
 (:func:`CompiledResidual.of` returns None for any other model, which then runs in Python).
 """
 
@@ -45,16 +45,18 @@ def _internal_force(internal, q, qd, qdd):
 
 
 @njit(cache=True)
-def residual_at(internal, forces, order, constraints, q, qd, qdd, mu):
+def residual_at(internal, forces, order, constraints, drive_loads, q, qd, qdd, mu):
     """The residual, internal and external forces of :meth:`DrillstringModel.evaluate` at (q, qd, qdd, mu), with
     what the wall's pass and the bit law gave (for the step's evaluation object), and whether q is still within
     the bound of the wall's culled vertices (False: the evaluation is not the model's, which would cull anew).
 
     ``forces``: (gravity load, wall rows, wall law, culling bound, reference q, reach, bit rows, bit unit loads,
-    bit law constants, damping matrix); ``order``: the kinds of the model's forces in its order."""
+    bit law constants, damping matrix); ``order``: the kinds of the model's forces in its order; ``drive_loads``:
+    the drive's generalised loads, the same at every state (:meth:`~fenics_drill.model.top_drive.TopDrive.
+    constant_loads`)."""
     gravity, flat, law, column_bound, q_ref, reach, bit_rows, bit_units, bit_law, damping = forces
     internal_force = _internal_force(internal, q, qd, qdd)
-    external = np.zeros(q.size)
+    external = drive_loads.copy()
     within = True
     wall = (np.empty(0), np.empty((0, 4)), np.empty((0, 4, 3)), 0.0, np.empty(0), np.empty((0, 2)),
             np.empty((0, 4)))
@@ -83,8 +85,8 @@ def residual_at(internal, forces, order, constraints, q, qd, qdd, mu):
 class CompiledResidual:
     """What :func:`residual_at` needs of one model: its internal force's cells and the forces' data."""
 
-    def __init__(self, model, internal: tuple, order: np.ndarray):
-        self.model, self.internal, self.order = model, internal, order
+    def __init__(self, model, internal: tuple, order: np.ndarray, drive_loads: np.ndarray):
+        self.model, self.internal, self.order, self.drive_loads = model, internal, order, drive_loads
         self.wall = model.force(WallContact.name)
         self._forces = (None, None)  # (the wall's vertex set, the forces' data for it) last given
 
@@ -92,11 +94,12 @@ class CompiledResidual:
     def of(cls, model) -> "CompiledResidual | None":
         """The compiled residual of ``model``, or None where it does not cover the model (module doc)."""
         internal = (model.internal.kernel_data() if isinstance(model.internal, AssembledInternalForce) else None)
-        if (internal is None or model.drive.inertia or not model.drive.held.all()
+        drive_loads = model.drive.constant_loads(model.size)
+        if (internal is None or drive_loads is None or model.drive.inertia
                 or any(type(f) not in _KINDS for f in model.forces)
                 or len({type(f) for f in model.forces}) != len(model.forces)):
             return None
-        return cls(model, internal, np.array([_KINDS[type(f)] for f in model.forces], dtype=np.int64))
+        return cls(model, internal, np.array([_KINDS[type(f)] for f in model.forces], dtype=np.int64), drive_loads)
 
     def forces(self):
         """The forces' data of :func:`residual_at` now (the wall's culled vertices are the last evaluation's),

@@ -159,6 +159,13 @@ class TopDrive:
                 d_angle, d_speed = -self.gains[1], -self.gains[0]
         return DriveLoads(self.rows.spread(np.array([force, torque])), force, torque, d_angle, d_speed)
 
+    def constant_loads(self, size: int) -> np.ndarray | None:
+        """The generalised loads of :meth:`evaluate` where they do not depend on the state (the rotation held: no
+        load, or the weight on bit of a hook load), else None (a speed controller's torque)."""
+        if not self.held[ROTATION]:
+            return None
+        return np.zeros(size) if self.held.all() else self.rows.spread(np.array([self.weight_on_bit, 0.0]))
+
     def tangent(self, loads: DriveLoads, c_u: float, c_v: float):
         """c_u df/dq + c_v df/dqd of the applied loads (None when the drive holds everything)."""
         if self.held[ROTATION]:

@@ -65,9 +65,10 @@ def _moves_less_than(motion_bound, motion_rows, dq, length):
 
 
 @kernel
-def kept_tangent_step(internal, forces, order, constraints, lu, mass, motion_rows, motion_bound, q0, qd0, qdd0, mu0,
-                      dt, newmark, target, levels, settling, max_iterations, drifted, rates):
-    """One step of :meth:`NewmarkNewton.step` whose Newton keeps the LU ``lu`` = (factors, pivots, k) throughout.
+def kept_tangent_step(internal, forces, order, constraints, drive_loads, lu, mass, motion_rows, motion_bound, q0,
+                      qd0, qdd0, mu0, dt, newmark, target, levels, settling, max_iterations, drifted, rates):
+    """One step of :meth:`NewmarkNewton.step` whose Newton keeps the LU ``lu`` = (factors, pivots, k) throughout;
+    the model is :func:`residual_at`'s (``internal`` to ``drive_loads``).
 
     ``newmark``: (gamma, beta); ``levels``: (force level, multiplier levels) of the accepted steps; ``settling``:
     (settle length, < 0 for none; SETTLED_SHARE); ``drifted``: whether a slow update would assemble df/dq afresh;
@@ -86,7 +87,7 @@ def kept_tangent_step(internal, forces, order, constraints, lu, mass, motion_row
     mu = mu0.copy()
     qdd = (q - q_pred) * c_a
     qd = qd_pred + g * dt * qdd
-    ev = residual_at(internal, forces, order, constraints, q, qd, qdd, mu)
+    ev = residual_at(internal, forces, order, constraints, drive_loads, q, qd, qdd, mu)
     norms, scales = np.empty(max_iterations), np.empty(max_iterations)
     kept, taken, iterations = True, False, 0
     norm = math.sqrt(np.dot(ev[0], ev[0]))
@@ -120,7 +121,8 @@ def kept_tangent_step(internal, forces, order, constraints, lu, mass, motion_row
         trial_q, trial_mu = q + dq, mu + dmu
         trial_qdd = (trial_q - q_pred) * c_a
         trial_qd = qd_pred + g * dt * trial_qdd
-        trial = residual_at(internal, forces, order, constraints, trial_q, trial_qd, trial_qdd, trial_mu)
+        trial = residual_at(internal, forces, order, constraints, drive_loads, trial_q, trial_qd, trial_qdd,
+                            trial_mu)
         trial_norm = math.sqrt(np.dot(trial[0], trial[0]))
         if not trial_norm < (1.0 - armijo) * norm:
             break  # Python would halve the update or step past a kink

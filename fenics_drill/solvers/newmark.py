@@ -281,7 +281,7 @@ class NewmarkNewton:
         rates = (TANGENT_REUSE_RATE, SLOW_CONTRACTION, SETTLED_CONTRACTION, SETTLED_FORCE_SHARE, ROUND_OFF, ARMIJO,
                  self.tolerance)
         taken, q, qd, qdd, mu, iterations, ev, force_level, multipliers, kept = kept_tangent_step(
-            self._compiled.internal, forces, self._compiled.order, model.constraints,
+            self._compiled.internal, forces, self._compiled.order, model.constraints, self._compiled.drive_loads,
             (lu.factors, lu.pivots, lu.scale), model.mass, model.motion_rows, self._motion_bound, state.q, state.qd,
             state.qdd, state.mu, dt, (self.gamma, self.beta), self.constraint_target(state.t + dt, h0),
             (self._force_level, self._multiplier_level), (settle, self.settled_share), self.max_iterations,

@@ -25,13 +25,15 @@ def _states(scene, t_end):
     return simulation, states
 
 
-@pytest.mark.parametrize("kinematics", ["objective", "printed"])
-def test_the_compiled_residual_is_the_models_own_evaluation(kinematics):
+@pytest.mark.parametrize("overrides", [("model.kinematics='objective'",), ("model.kinematics='printed'",),
+                                       ("drive.mode='hook_load'", "drive.weight_on_bit=20e3")],
+                         ids=["objective", "printed kinematics", "hook load"])
+def test_the_compiled_residual_is_the_models_own_evaluation(overrides):
     """At the states a run passes through (on and off the wall, the bit cutting and lifted), the compiled
     residual, internal and external forces, the wall's indentations and the bit's force are the model's own:
     the same kernels summed in the same order, so equal to the round-off of a BLAS product (1e-12 of the
-    largest entry; measured: bitwise equal)."""
-    scene = scene_with(*STRING, "solver.compiled_step=false", f"model.kinematics='{kinematics}'")
+    largest entry; measured: bitwise equal), with either kinematics and with the drive's weight on bit."""
+    scene = scene_with(*STRING, "solver.compiled_step=false", *overrides)
     simulation, states = _states(scene, 0.05)
     model = simulation.model
     compiled = CompiledResidual.of(model)
@@ -40,8 +42,8 @@ def test_the_compiled_residual_is_the_models_own_evaluation(kinematics):
         ev = model.evaluate(state.q, state.qd, state.qdd, state.mu)
         forces = compiled.forces()
         residual, internal, external, wall, bit, within = residual_at(compiled.internal, forces, compiled.order,
-                                                                      model.constraints, state.q, state.qd,
-                                                                      state.qdd, state.mu)
+                                                                      model.constraints, compiled.drive_loads,
+                                                                      state.q, state.qd, state.qdd, state.mu)
         assert within
         for mine, theirs in ((residual, ev.residual), (internal, ev.internal), (external, ev.external)):
             np.testing.assert_allclose(mine, theirs, rtol=0, atol=1e-12 * np.abs(ev.internal).max())
@@ -65,7 +67,9 @@ def test_the_compiled_saddle_solve_is_lapacks():
     np.testing.assert_allclose(mu, expected[1], rtol=0, atol=1e-12 * scale)
 
 
-def test_a_run_with_compiled_steps_is_the_python_run():
+@pytest.mark.parametrize("drive", [(), ("drive.mode='hook_load'", "drive.weight_on_bit=20e3")],
+                         ids=["held drive", "hook load"])
+def test_a_run_with_compiled_steps_is_the_python_run(drive):
     """Over 0.25 s of the 30 m string (resting on the wall, the bit bouncing off the rock), the run whose steps
     that keep their tangent are compiled takes the same steps and Newton iterations as the run in Python, most of
     its steps compiled, and ends at the same state to the round-off of its products and solves, far inside the
@@ -73,7 +77,7 @@ def test_a_run_with_compiled_steps_is_the_python_run():
     asserted 1e-3 of one step's bound; the drive's work 3e-9 J apart, asserted 1e-9 of it."""
     runs = []
     for compiled in ("true", "false"):
-        scene = scene_with(*STRING, f"solver.compiled_step={compiled}")
+        scene = scene_with(*STRING, *drive, f"solver.compiled_step={compiled}")
         prepared = prepare(scene)
         simulation = Simulation(prepared.model, scene)
         final = simulation.run(simulation.initial_state(prepared.equilibrium.q), 0.25)
@@ -89,11 +93,11 @@ def test_a_run_with_compiled_steps_is_the_python_run():
     assert budget.input_work == pytest.approx(python_budget.input_work, rel=1e-9)
 
 
-@pytest.mark.parametrize("overrides", [("reduction.rule='none'",), ("drive.mode='hook_load'",),
-                                       ("bit_rock.law='detournay'",), ("drive.controller='pi'",)],
-                         ids=["full order", "hook load", "cutting bit", "PI top drive"])
+@pytest.mark.parametrize("overrides", [("reduction.rule='none'",), ("bit_rock.law='detournay'",),
+                                       ("drive.controller='pi'",)],
+                         ids=["full order", "cutting bit", "PI top drive"])
 def test_models_it_does_not_cover_run_in_python(overrides):
-    """The full order, a drive that applies its loads, a top drive's inertia and a bit law with a memory are not
-    what the compiled residual sums: their models have none, and every step is Python's."""
+    """The full order, a top drive's inertia and torque controller and a bit law with a memory are not what the
+    compiled residual sums: their models have none, and every step is Python's."""
     model = build_model(scene_with(*STRING, *overrides))
     assert CompiledResidual.of(model) is None
