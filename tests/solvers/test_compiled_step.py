@@ -73,8 +73,9 @@ def test_a_run_with_compiled_steps_is_the_python_run(drive):
     """Over 0.25 s of the 30 m string (resting on the wall, the bit bouncing off the rock), the run whose steps
     that keep their tangent are compiled takes the same steps and Newton iterations as the run in Python, most of
     its steps compiled, and ends at the same state to the round-off of its products and solves, far inside the
-    stopping test's bound (SETTLED_SHARE of the error tolerance per step): measured 4e-14 m apart on the surface,
-    asserted 1e-3 of one step's bound; the drive's work 3e-9 J apart, asserted 1e-9 of it."""
+    stopping test's bound (SETTLED_SHARE of the error tolerance per step): measured 4e-14 m apart on the surface
+    (7e-14 m under the hook load), asserted 1e-3 of one step's bound; the drive's work 3e-9 J apart (6e-9 J),
+    asserted 1e-9 of it."""
     runs = []
     for compiled in ("true", "false"):
         scene = scene_with(*STRING, *drive, f"solver.compiled_step={compiled}")
@@ -84,8 +85,8 @@ def test_a_run_with_compiled_steps_is_the_python_run(drive):
         runs.append((final, simulation.stats, simulation.stepper.compiled_steps, simulation.budget))
     (final, stats, compiled_steps, budget), (python, python_stats, python_compiled, python_budget) = runs
     assert python_compiled == 0
-    # measured 0.91 of the steps; the rest start with a fresh tangent (every tangent_reuse steps, after a step
-    # of three evaluations) or hand the step back
+    # measured 0.91 of the steps (0.97 under the hook load); the rest start with a fresh tangent (every
+    # tangent_reuse steps, after a step of three evaluations) or hand the step back
     assert compiled_steps > 0.5 * stats["steps"]
     assert (stats["steps"], stats["newton_iterations"]) == (python_stats["steps"], python_stats["newton_iterations"])
     moved = np.max(np.abs(prepared.model.motion_rows @ (final.q - python.q)))
