@@ -30,6 +30,11 @@ from fenics_drill.model.out_of_band_damping import OutOfBandDamping
 GRAVITY, WALL, BIT_ROCK, DAMPING = 0, 1, 2, 3
 _KINDS = {Gravity: GRAVITY, WallContact: WALL, BitRock: BIT_ROCK, OutOfBandDamping: DAMPING}
 
+#: What :func:`residual_at` gives of a wall and a bit the model does not have.
+NO_WALL = (np.empty(0), np.empty((0, 4)), np.empty((0, 4, 3)), 0.0, np.empty(0), np.empty((0, 2)), np.empty((0, 4)))
+NO_BIT = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
 @njit(cache=True)
 def _internal_force(internal, q, qd, qdd):
     """:meth:`AssembledInternalForce.evaluate` of a modal space: [K C M] (q, qd, qdd) plus the sampled
@@ -58,9 +63,7 @@ def residual_at(internal, forces, order, constraints, drive_loads, q, qd, qdd, m
     internal_force = _internal_force(internal, q, qd, qdd)
     external = drive_loads.copy()
     within = True
-    wall = (np.empty(0), np.empty((0, 4)), np.empty((0, 4, 3)), 0.0, np.empty(0), np.empty((0, 2)),
-            np.empty((0, 4)))
-    bit = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    wall, bit = NO_WALL, NO_BIT
     for kind in order:
         if kind == GRAVITY:
             external += gravity

@@ -20,6 +20,8 @@ import numpy as np
 from numba import njit
 
 from fenics_drill.model.compiled import kernel
+from fenics_drill.model.compiled_residual import NO_BIT as _NO_BIT
+from fenics_drill.model.compiled_residual import NO_WALL as _NO_WALL
 from fenics_drill.model.compiled_residual import residual_at
 
 
@@ -66,9 +68,10 @@ def _moves_less_than(motion_bound, motion_rows, dq, length):
 
 @kernel
 def kept_tangent_step(internal, forces, order, constraints, drive_loads, lu, mass, motion_rows, motion_bound, q0,
-                      qd0, qdd0, mu0, dt, newmark, target, levels, settling, max_iterations, drifted, rates):
+                      qd0, qdd0, mu0, dt, newmark, target, levels, settling, max_iterations, drifted, rates, start):
     """One step of :meth:`NewmarkNewton.step` whose Newton keeps the LU ``lu`` = (factors, pivots, k) throughout;
-    the model is :func:`residual_at`'s (``internal`` to ``drive_loads``).
+    the model is :func:`residual_at`'s (``internal`` to ``drive_loads``).  ``start``: the (residual, internal,
+    external) forces at the predictor, evaluated already (empty arrays: evaluated here).
 
     ``newmark``: (gamma, beta); ``levels``: (force level, multiplier levels) of the accepted steps; ``settling``:
     (settle length, < 0 for none; SETTLED_SHARE); ``drifted``: whether a slow update would assemble df/dq afresh;
@@ -87,7 +90,10 @@ def kept_tangent_step(internal, forces, order, constraints, drive_loads, lu, mas
     mu = mu0.copy()
     qdd = (q - q_pred) * c_a
     qd = qd_pred + g * dt * qdd
-    ev = residual_at(internal, forces, order, constraints, drive_loads, q, qd, qdd, mu)
+    if start[0].size:  # the caller's evaluation at the predictor, whose culled vertices hold it
+        ev = (start[0], start[1], start[2], _NO_WALL, _NO_BIT, True)
+    else:
+        ev = residual_at(internal, forces, order, constraints, drive_loads, q, qd, qdd, mu)
     norms, scales = np.empty(max_iterations), np.empty(max_iterations)
     kept, taken, iterations = True, False, 0
     norm = math.sqrt(np.dot(ev[0], ev[0]))

@@ -60,6 +60,9 @@ SETTLED_CONTRACTION = 0.5
 #: same time (benchmarks/RESULTS.md, item 59).
 CARRY_WITHIN = 2
 
+#: The predictor's forces of a compiled step that evaluates them itself.
+_NOT_EVALUATED = (np.empty(0), np.empty(0), np.empty(0))
+
 #: Which parts (df/dq, df/dqd, df/dqdd) of the internal tangent an evaluation assembles afresh.
 ALL_PARTS, STIFFNESS_PART, NO_PART = (True, True, True), (True, False, False), (False, False, False)
 
@@ -249,7 +252,7 @@ class NewmarkNewton:
         if self._carried.matrix is None and self._compiled is not None:
             # the tangent Newton takes at its first update, formed now: the rest of the step is the compiled one
             self._carried.matrix = ev.tangent
-            taken = self._compiled_step(state, dt, h0)
+            taken = self._compiled_step(state, dt, h0, ev)
             if taken is not None:
                 if taken[1] == 1:  # converged at the predictor: this Newton forms no tangent, and carries none
                     self._carried.matrix = None
@@ -264,11 +267,13 @@ class NewmarkNewton:
             raise NewtonFailure(f"Newton did not converge in {self.max_iterations} iterations at dt = {dt:.3e} s")
         return result
 
-    def _compiled_step(self, state: State, dt: float, h0: np.ndarray) -> tuple[State, int, Evaluation] | None:
+    def _compiled_step(self, state: State, dt: float, h0: np.ndarray,
+                       predicted: Evaluation | None = None) -> tuple[State, int, Evaluation] | None:
         """The step as :meth:`step` takes it, by :func:`~fenics_drill.solvers.compiled_step.kept_tangent_step`,
         when it starts with a tangent kept for it (the last step's, or the one :meth:`step` formed at its
-        predictor) and its internal parts are not due to be assembled; None when it does not, or when the
-        compiled step hands it back (then :meth:`step` takes it in Python)."""
+        predictor, whose evaluation ``predicted`` is not repeated) and its internal parts are not due to be
+        assembled; None when it does not, or when the compiled step hands it back (then :meth:`step` takes it in
+        Python)."""
         if (self._compiled is None or self._carried.matrix is None or dt != self._carried_dt
                 or self._internal_parts is None or self._steps_since_tangent >= self.tangent_reuse):
             return None
@@ -285,7 +290,8 @@ class NewmarkNewton:
             (lu.factors, lu.pivots, lu.scale), model.mass, model.motion_rows, self._motion_bound, state.q, state.qd,
             state.qdd, state.mu, dt, (self.gamma, self.beta), self.constraint_target(state.t + dt, h0),
             (self._force_level, self._multiplier_level), (settle, self.settled_share), self.max_iterations,
-            self._steps_since_stiffness > 0 and model.internal.state_dependent, rates)
+            self._steps_since_stiffness > 0 and model.internal.state_dependent, rates,
+            _NOT_EVALUATED if predicted is None else (predicted.residual, predicted.internal, predicted.external))
         if not taken:
             return None
         self._force_level, self._multiplier_level = force_level, multipliers
@@ -294,6 +300,8 @@ class NewmarkNewton:
         if not kept or iterations > CARRY_WITHIN:
             self._carried.matrix = None
         self.compiled_steps += 1
+        if predicted is not None and iterations == 1:  # the predictor is the step's result
+            return State(state.t + dt, q, qd, qdd, mu), iterations, predicted
         residual, internal, external, wall, _, _ = ev
         coefficients = (1.0, self.gamma / (self.beta * dt), 1.0 / (self.beta * dt * dt))
         evaluation = model.evaluation_at(q, qd, residual, internal, external, self._compiled.evaluations(q, qd, wall),
