@@ -40,7 +40,9 @@ def test_a_tangent_part_exists_exactly_where_the_nonlinear_remainder_depends_on_
     test_hyper_reduction.py (every element at unit weight against the unsampled model)."""
     from fenics_drill.model.internal_force import AssembledInternalForce, ElementSample
 
-    scene = scene_with("beam.length=10.0", "beam.elements=20", f"model.geometric_nonlinearity={str(geometric).lower()}",
+    # 60 m: the basis holds flexural modes of both planes, which the inertial remainder needs (omega_1 of (13)
+    # couples theta_x and theta_z through theta_y); a 10 m string's holds only the w plane's sag at 120 rpm
+    scene = scene_with("beam.length=60.0", "beam.elements=20", f"model.geometric_nonlinearity={str(geometric).lower()}",
                        f"model.inertial_nonlinearity={str(inertial).lower()}")
     model = build_model(scene)
     m = scene.model
@@ -57,7 +59,7 @@ def test_a_tangent_part_exists_exactly_where_the_nonlinear_remainder_depends_on_
         nonlinear = np.asarray(part) - linear
         if expected[k]:
             # not identically zero (a form kept for a field that cancels assembles exact zeros); the share is
-            # small (1e-11 of the mass for df/dqdd: a modal state of order one is a small physical rotation)
+            # small (2e-5 of the mass for df/dqdd: a modal state of order one is a small physical rotation)
             assert nonlinear.any()
         else:
             assert not nonlinear.any()
