@@ -3,7 +3,8 @@
 Solve: K phi = omega^2 M phi with SLEPc, Krylov-Schur with shift-and-invert about a
 small negative target, so the two rigid-body modes (u and theta_x are free) and the
 lowest elastic modes come first; support dofs are Dirichlet rows that never enter the
-spectrum.  Every mode is classified from its kinetic-energy fractions per field.
+spectrum.  The problem is solved for each group of fields that K and M couple (four for the straight
+string).  Every mode is classified from its kinetic-energy fractions per field.
 
 Select: the modes a scene's ``reduction.rule`` keeps (the paper's Section 6.3 bands,
 Table 4; the 'auto' bands of what the scene excites and its step resolves, with the
