@@ -78,6 +78,18 @@ def _sampled_at(c, p, monomials, young_modulus, shear_modulus):
 
 
 @njit(cache=True, inline="always")
+def _monomial_bound_at(c, p, monomial_bounds, young_modulus, shear_modulus):
+    """A cheaper, looser bound than :func:`_bound_at`: each strain bounded by the sum of its monomials'
+    largest magnitudes on the fibre (``monomial_bounds``)."""
+    exx = exy = exz = 0.0
+    for m in range(monomial_bounds.size):
+        exx += abs(c[p, 0, m]) * monomial_bounds[m]
+        exy += abs(c[p, 1, m]) * monomial_bounds[m]
+        exz += abs(c[p, 2, m]) * monomial_bounds[m]
+    return _von_mises_squared(exx, exy, exz, young_modulus, shear_modulus)
+
+
+@njit(cache=True, inline="always")
 def _largest_singular_value(a, b, c, d):
     """The largest singular value of [[a, b], [c, d]], in a form free of cancellation."""
     return 0.5 * (math.sqrt((a + d) ** 2 + (c - b) ** 2) + math.sqrt((a - d) ** 2 + (b + c) ** 2))
@@ -92,12 +104,12 @@ def _bound_at(c, p, radius, young_modulus, shear_modulus):
     stress itself where axial load, bending and torsion combine (the shear's length is then constant
     around the fibre); a relative 1e-9 covers the round-off of the sampled stress it is compared with."""
     half_r2 = 0.5 * radius * radius
-    mean = np.empty(3)
-    for k in range(3):
-        mean[k] = c[p, k, 0] + half_r2 * (c[p, k, 3] + c[p, k, 5])
-    axial = (abs(mean[0]) + radius * math.sqrt(c[p, 0, 1] ** 2 + c[p, 0, 2] ** 2)
+    mean_xx = c[p, 0, 0] + half_r2 * (c[p, 0, 3] + c[p, 0, 5])
+    mean_xy = c[p, 1, 0] + half_r2 * (c[p, 1, 3] + c[p, 1, 5])
+    mean_xz = c[p, 2, 0] + half_r2 * (c[p, 2, 3] + c[p, 2, 5])
+    axial = (abs(mean_xx) + radius * math.sqrt(c[p, 0, 1] ** 2 + c[p, 0, 2] ** 2)
              + half_r2 * math.sqrt((c[p, 0, 3] - c[p, 0, 5]) ** 2 + c[p, 0, 4] ** 2))
-    shear = (math.sqrt(mean[1] ** 2 + mean[2] ** 2)
+    shear = (math.sqrt(mean_xy ** 2 + mean_xz ** 2)
              + radius * _largest_singular_value(c[p, 1, 1], c[p, 1, 2], c[p, 2, 1], c[p, 2, 2])
              + half_r2 * _largest_singular_value(c[p, 1, 3] - c[p, 1, 5], c[p, 1, 4], c[p, 2, 3] - c[p, 2, 5],
                                                  c[p, 2, 4]))
@@ -114,15 +126,15 @@ def _sampled_maxima(c, points, monomials, young_modulus, shear_modulus):
 
 
 @njit(cache=True)
-def _largest(c, monomials, radius, young_modulus, shear_modulus):
+def _largest(c, monomials, monomial_bounds, radius, young_modulus, shear_modulus):
     """(the largest sampled sigma_VM^2 over all points of ``c``, its point): the sections are sampled only
-    where the bound of :func:`_bound_at` reaches the stress sampled at the point of largest bound (NaN if
-    no bound does: a non-finite state)."""
+    where the bounds of :func:`_monomial_bound_at` and :func:`_bound_at` reach the stress sampled at the
+    point of largest cheap bound (NaN if no bound does: a non-finite state)."""
     n = c.shape[0]
     bound = np.empty(n)
     first = 0
     for p in range(n):
-        bound[p] = _bound_at(c, p, radius, young_modulus, shear_modulus)
+        bound[p] = _monomial_bound_at(c, p, monomial_bounds, young_modulus, shear_modulus)
         if bound[p] > bound[first]:
             first = p
     # (1 - 1e-9): the bound and the sampled stress are equal where one monomial carries the strain, and
@@ -130,7 +142,7 @@ def _largest(c, monomials, radius, young_modulus, shear_modulus):
     reached = (1.0 - 1e-9) * _sampled_at(c, first, monomials, young_modulus, shear_modulus)
     largest, at = np.nan, first
     for p in range(n):
-        if bound[p] >= reached:
+        if bound[p] >= reached and _bound_at(c, p, radius, young_modulus, shear_modulus) >= reached:
             value = _sampled_at(c, p, monomials, young_modulus, shear_modulus)
             if not value <= largest:  # the first of the largest (and any value beats NaN)
                 largest, at = value, p
@@ -149,7 +161,8 @@ def _at_ends(c, ends):
 
 
 @kernel
-def _batch_maxima(sampled, end_cells, dofs_rows, monomials, radius, young_modulus, shear_modulus, ends):
+def _batch_maxima(sampled, end_cells, dofs_rows, monomials, monomial_bounds, radius, young_modulus,
+                  shear_modulus, ends):
     """:func:`_largest` of each state (a row of ``dofs_rows``) over the strains' coefficients of the expression
     ``sampled`` (address, cell dofs, constants, coordinates, size: :func:`~fenics_drill.model.cell_kernels.
     tabulate_at_cells`), or the stress recovered at an end (:func:`_at_ends` of the coefficients that the
@@ -161,7 +174,7 @@ def _batch_maxima(sampled, end_cells, dofs_rows, monomials, radius, young_modulu
     for s in range(dofs_rows.shape[0]):
         tabulate_at_cells(address, dofs_rows[s], cell_dofs, constants, coordinates, strains)
         c = strains.reshape(-1, 3, monomials.shape[0])
-        values[s], at[s] = _largest(c, monomials, radius, young_modulus, shear_modulus)
+        values[s], at[s] = _largest(c, monomials, monomial_bounds, radius, young_modulus, shear_modulus)
         tabulate_at_cells(end_address, dofs_rows[s], end_dofs, end_constants, end_coordinates, at_end_cells)
         recovered = _at_ends(at_end_cells.reshape(-1, 3, monomials.shape[0]), ends)
         for e in range(ends.shape[0]):
@@ -194,6 +207,9 @@ class VonMisesProbe:
         y, z = outer_fibre(p.outer_radius).T
         self.monomials = np.stack([y**a * z**b for a, b in MONOMIALS])  # (6, samples)
         self.outer_radius = p.outer_radius
+        # max |y^a z^b| on the circle r = R_ext: R^(a+b) times max |cos^a sin^b| (1 or 1/2 for a = b = 1)
+        self.monomial_bounds = np.array([p.outer_radius ** (a + b) * (0.5 if a == b == 1 else 1.0)
+                                         for a, b in MONOMIALS])
         x = disc.mesh.geometry.x[:, 0]
         cell_vertices = disc.mesh.geometry.dofmaps[0]  # (cells, 2) for the affine interval
         x0, x1 = x[cell_vertices[:, 0]], x[cell_vertices[:, 1]]
@@ -240,7 +256,8 @@ class VonMisesProbe:
         expressions = tuple((e.address, e.cell_dofs, e.constants, e.coordinates, e.size)
                             for e in (self._at_element_ends, self._at_end_cells))
         squared, at = _batch_maxima(*expressions, np.ascontiguousarray(dofs_rows, dtype=float), self.monomials,
-                                    self.outer_radius, self.E, self.G, self._end_midpoints)
+                                    self.monomial_bounds, self.outer_radius, self.E, self.G,
+                                    self._end_midpoints)
         return np.sqrt(squared), self._point_x[at]
 
     def maximum(self, dofs: np.ndarray) -> tuple[float, float]:
