@@ -55,11 +55,11 @@ def residual_at(internal, forces, order, constraints, drive_loads, q, qd, qdd, m
     what the wall's pass and the bit law gave (for the step's evaluation object), and whether q is still within
     the bound of the wall's culled vertices (False: the evaluation is not the model's, which would cull anew).
 
-    ``forces``: (gravity load, wall rows, wall law, culling bound, reference q, reach, bit rows, bit unit loads,
-    bit law constants, damping matrix); ``order``: the kinds of the model's forces in its order; ``drive_loads``:
+    ``forces``: (gravity load, wall rows (packed: values, columns), wall law, culling bound, reference q, reach,
+    bit rows, bit unit loads, bit law constants, damping matrix); ``order``: the kinds of the model's forces in its order; ``drive_loads``:
     the drive's generalised loads, the same at every state (:meth:`~fenics_drill.model.top_drive.TopDrive.
     constant_loads`)."""
-    gravity, flat, law, column_bound, q_ref, reach, bit_rows, bit_units, bit_law, damping = forces
+    gravity, wall_rows, law, column_bound, q_ref, reach, bit_rows, bit_units, bit_law, damping = forces
     internal_force = _internal_force(internal, q, qd, qdd)
     external = drive_loads.copy()
     within = True
@@ -69,7 +69,8 @@ def residual_at(internal, forces, order, constraints, drive_loads, q, qd, qdd, m
             external += gravity
         elif kind == WALL:
             within = np.dot(column_bound, np.abs(q - q_ref)) < reach
-            wall = WALL_PASS(flat, q, qd, law[0], law[1], law[2], law[3], law[4], law[5], law[6], law[7], law[8])
+            wall = WALL_PASS(wall_rows[0], wall_rows[1], q.size, q, qd, law[0], law[1], law[2], law[3], law[4], law[5],
+                             law[6], law[7], law[8])
             external += wall[4]
         elif kind == BIT_ROCK:
             rates = np.dot(bit_rows, qd)
@@ -118,8 +119,9 @@ class CompiledResidual:
         size = self.model.size
         gravity, bit, damping = (self.model.force(name) for name in (Gravity.name, BitRock.name,
                                                                     OutOfBandDamping.name))
+        no_rows = ((np.empty((0, 0)),) * 4, (np.empty(0, dtype=np.int64),) * 4)
         wall = (self.wall.kernel_data(vertices) if self.wall is not None else
-                (np.empty((0, size)), (0.0,) * 4 + (False,) + (0.0,) * 4, np.zeros(size), np.zeros(size), np.inf))
+                (no_rows, (0.0,) * 4 + (False,) + (0.0,) * 4, np.zeros(size), np.zeros(size), np.inf))
         bit_data = bit.kernel_data() if bit is not None else (np.empty((2, size)), np.empty((2, size)), (0.0,) * 4)
         return (np.zeros(size) if gravity is None else gravity.load, *wall, *bit_data,
                 np.empty((0, size)) if damping is None else damping.damping)

@@ -132,8 +132,9 @@ def test_cell_assembly_refuses_a_bilinear_form_of_two_spaces(sampled_forms):
 def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
     """In the default (modal) space, at 20 random states around the string's rest on the wall, the one-pass
     kernel gives (1) the positions and rates [Phi] q, [Phi] qd, (2) the pointwise law (16)-(19) at them and
-    (3) [Phi]^T of its loads, and (:func:`_projected_laws`) of each law's loads.  They sum in another order than BLAS (reassociated,
-    vectorised) and may fuse multiply-adds, so each part is held to the round-off that allows, nothing looser:
+    (3) [Phi]^T of its loads, and (:func:`_projected_laws`) of each law's loads.  They read the rows packed by
+    field and sum in another order than BLAS (reassociated, vectorised) and may fuse multiply-adds, so each part
+    is held to the round-off that allows, nothing looser:
 
     * a sum of n products in any order differs by at most n eps sum|terms| (Higham, Accuracy and Stability,
       Sec. 3.1): the bound for (1), with n = 64 >= the 59 terms of a row, and for (3), with n = 4 rows per
@@ -145,15 +146,22 @@ def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
     model = prepare(scene, dynamics=False).model
     resting = solve_static(model).q  # on the wall near the bit
     wall = model.force("wall")
-    flat, lateral_rows = wall.every.flat, wall.every.lateral_rows
+    flat, lateral_rows, packed = wall.every.flat, wall.every.lateral_rows, wall.every.packed
+    # the rows packed by field, scattered back, are the dense ones (the kernel reads only those)
+    for f, (values, columns) in enumerate(zip(packed.values, packed.columns)):
+        dense = np.zeros_like(flat[f::4])
+        np.add.at(dense.T, columns, values.T)
+        assert np.array_equal(dense, flat[f::4])
+        assert values.shape[1] < flat.shape[1]  # and fewer than all columns (modes move one group of fields)
     rng = np.random.default_rng(11)
     eps, terms = np.finfo(float).eps, 64
     touched = 0
     for _ in range(20):
         q = resting * (1 + 0.05 * rng.standard_normal(model.size))
         qd = rng.standard_normal(model.size) * 0.5
-        delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(flat, q, qd, *wall._law())
-        projected = _projected_laws(flat, delta, laws)
+        delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(
+            packed.values, packed.columns, model.size, q, qd, *wall._law())
+        projected = _projected_laws(packed.values, packed.columns, model.size, delta, laws)
         # (1) positions and rates
         position_bound = terms * eps * (np.abs(lateral_rows) @ np.abs(q)).reshape(-1, 2)
         rate_bound = terms * eps * (np.abs(flat) @ np.abs(qd)).reshape(-1, 4)

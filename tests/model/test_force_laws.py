@@ -53,3 +53,17 @@ def test_printed_damper_grows_with_the_impact_speed_and_still_dissipates():
     printed = wall_contact.hunt_crossley_damper(1e-4, 0.5, c, "printed")[0]
     consistent = wall_contact.hunt_crossley_damper(1e-4, 0.5, c, "consistent")[0]
     assert printed / consistent == pytest.approx(0.5**3 / 1e-12, rel=1e-12)  # a ratio of two products: round-off
+
+
+def test_the_regularised_sign_is_tanh_to_the_last_bit_where_it_saturates_too():
+    """The friction's sgn skips tanh where it rounds to +-1 (|x / v_s| > SATURATED): over 1e-3 to 1e300 of
+    either sign, and at NaN, it returns exactly what the compiled tanh returns (NumPy's own tanh may differ
+    from LLVM's by an ulp, which is not what this checks)."""
+    from numba import njit
+
+    sign = njit(lambda x, scale: wall_contact._regularised_sign(x, scale))
+    tanh = njit(lambda x, scale: np.tanh(x / scale))
+    ratios = np.concatenate(([0.0], np.geomspace(1e-3, 1e300, 20000)))
+    for x in np.concatenate((ratios, -ratios)) * 1e-3:
+        assert sign(x, 1e-3) == tanh(x, 1e-3)
+    assert np.isnan(sign(np.nan, 1e-3))

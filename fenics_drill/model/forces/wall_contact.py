@@ -52,10 +52,18 @@ def _normal_force(delta, delta_rate, stiffness_linear, stiffness_cubic, damping,
     return min(force, 0.0)
 
 
+#: Above this |x|, tanh(x) rounds to +-1 in double precision (from 18.99): the friction torque of a spinning
+#: string is there at every vertex, and the sign costs less than the call.
+SATURATED = 19.5
+
+
 @njit(cache=True, inline="always")
 def _regularised_sign(x, velocity_scale):
     """tanh(x / velocity_scale): Coulomb's sgn, smoothed so Newton can converge."""
-    return np.tanh(x / velocity_scale)
+    ratio = x / velocity_scale
+    if abs(ratio) > SATURATED:
+        return 1.0 if ratio > 0.0 else -1.0
+    return np.tanh(ratio)
 
 
 def hunt_crossley_damper(delta, delta_rate, damping, law="consistent"):
@@ -140,37 +148,105 @@ def _vertex_loads(lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_to
     return delta, nodal, laws, potential
 
 
+@dataclass(frozen=True)
+class PackedRows:
+    """The rows of [Phi] of each field of FIELDS at some vertices, each on the columns where that field's rows
+    are nonzero.  The modes of the straight string move one group of fields each (model/modes.py), so a
+    field's rows are nonzero on a fraction of the columns: on the paper scene's basis u, v, w and theta_x
+    have 13, 11, 14 and 27 of 62, and a pass over them reads a quarter of the dense rows.  Each field's
+    columns are padded with zeros to a multiple of PADDING, which spares the vectorised loops their
+    remainders (the wall's pass took 26 us against 28-29 us unpadded)."""
+
+    values: tuple  # per field, (vertices, its columns)
+    columns: tuple  # per field, its columns (int64; a padding column is column 0, with zero rows)
+
+    PADDING: ClassVar[int] = 4
+
+    @classmethod
+    def of(cls, flat: np.ndarray) -> "PackedRows":
+        """The packed form of the dense rows ``flat`` ((u, v, w, theta_x) of each vertex, interleaved)."""
+        values, columns = [], []
+        for rows in (flat[f::len(FIELDS)] for f in range(len(FIELDS))):
+            nonzero = np.flatnonzero(np.any(rows != 0.0, axis=0))
+            padded = -(-nonzero.size // cls.PADDING) * cls.PADDING
+            columns.append(np.zeros(padded, dtype=np.int64))
+            columns[-1][:nonzero.size] = nonzero
+            values.append(np.zeros((rows.shape[0], padded)))
+            values[-1][:, :nonzero.size] = rows[:, nonzero]
+        return cls(tuple(values), tuple(columns))
+
+    def at(self, vertices: np.ndarray) -> "PackedRows":
+        """The rows of some of the vertices (indices into these)."""
+        return PackedRows(tuple(np.ascontiguousarray(rows[vertices]) for rows in self.values), self.columns)
+
+
+@njit(cache=True, inline="always")
+def _dot_row(rows, i, x):
+    """rows[i] . x, without a view of the row."""
+    s = 0.0
+    for j in range(x.size):
+        s += rows[i, j] * x[j]
+    return s
+
+
+@njit(cache=True, inline="always")
+def _dot_row_twice(rows, i, x, y):
+    """(rows[i] . x, rows[i] . y), reading the row once."""
+    s = t = 0.0
+    for j in range(x.size):
+        s += rows[i, j] * x[j]
+        t += rows[i, j] * y[j]
+    return s, t
+
+
+@njit(cache=True, inline="always")
+def _add_row(out, rows, i, factor):
+    """out += factor rows[i], without a view of the row."""
+    for j in range(out.size):
+        out[j] += factor * rows[i, j]
+
+
+@njit(cache=True, inline="always")
+def _scatter(out, columns, packed):
+    """out[columns] += packed."""
+    for j in range(columns.size):
+        out[columns[j]] += packed[j]
+
+
 @kernel(fastmath=REASSOCIATE)
-def _modal_pass(flat, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s):
-    """:func:`_vertex_loads` in a modal space, in one pass over the dense rows ``flat`` of [Phi]
-    ((u, v, w, theta_x) of each vertex, interleaved): each vertex's positions and rates, its law, and
-    [Phi]^T of its nodal loads, while its four rows are in cache.  Also returns the positions and rates.
-    The split by law is left to :func:`_projected_laws` (the budget reads it at accepted steps only: in the
-    pass it cost a sixth of the pass at every Newton iterate)."""
-    n, size = flat.shape[0] // 4, flat.shape[1]
+def _modal_pass(values, columns, size, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s):
+    """:func:`_vertex_loads` in a modal space (``size`` coordinates), in one pass over the rows of [Phi] packed by
+    field (:class:`PackedRows` ``values``, ``columns``): each vertex's positions and rates, its law, and [Phi]^T
+    of its nodal loads, while its rows are in cache.  Also returns the positions and rates.  The split by law
+    is left to :func:`_projected_laws` (the budget reads it at accepted steps only: in the pass it cost a
+    sixth of the pass at every Newton iterate)."""
+    rows_u, rows_v, rows_w, rows_t = values
+    n = rows_u.shape[0]
+    q_v, q_w = q[columns[1]], q[columns[2]]
+    qd_u, qd_v, qd_w, qd_t = qd[columns[0]], qd[columns[1]], qd[columns[2]], qd[columns[3]]
+    load_u, load_v, load_w, load_t = (np.zeros(columns[0].size), np.zeros(columns[1].size),
+                                      np.zeros(columns[2].size), np.zeros(columns[3].size))
     delta, nodal, laws = np.empty(n), np.zeros((n, 4)), np.zeros((n, 4, 3))
     lateral, rates = np.empty((n, 2)), np.empty((n, 4))
-    generalised = np.zeros(size)
     potential = 0.0
     for i in range(n):
-        base = 4 * i
-        v = w = r0 = r1 = r2 = r3 = 0.0
-        for j in range(size):
-            v += flat[base + 1, j] * q[j]
-            w += flat[base + 2, j] * q[j]
-            r0 += flat[base, j] * qd[j]
-            r1 += flat[base + 1, j] * qd[j]
-            r2 += flat[base + 2, j] * qd[j]
-            r3 += flat[base + 3, j] * qd[j]
+        v, rate_v = _dot_row_twice(rows_v, i, q_v, qd_v)
+        w, rate_w = _dot_row_twice(rows_w, i, q_w, qd_w)
         lateral[i, 0], lateral[i, 1] = v, w
-        rates[i, 0], rates[i, 1], rates[i, 2], rates[i, 3] = r0, r1, r2, r3
+        rates[i, 0], rates[i, 1], rates[i, 2], rates[i, 3] = _dot_row(rows_u, i, qd_u), rate_v, rate_w, _dot_row(
+            rows_t, i, qd_t)
         potential += _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh,
                                  v_s, delta, nodal, laws)
         if delta[i] > 0.0:
-            axial, load_v, load_w, torque = nodal[i, 0], nodal[i, 1], nodal[i, 2], nodal[i, 3]
-            for j in range(size):
-                generalised[j] += (flat[base, j] * axial + flat[base + 1, j] * load_v + flat[base + 2, j] * load_w
-                                   + flat[base + 3, j] * torque)
+            _add_row(load_u, rows_u, i, nodal[i, 0])
+            _add_row(load_v, rows_v, i, nodal[i, 1])
+            _add_row(load_w, rows_w, i, nodal[i, 2])
+            _add_row(load_t, rows_t, i, nodal[i, 3])
+    generalised = np.zeros(size)
+    _scatter(generalised, columns[0], load_u)
+    _scatter(generalised, columns[1], load_v)
+    _scatter(generalised, columns[2], load_w)
+    _scatter(generalised, columns[3], load_t)
     return delta, nodal, laws, potential, generalised, lateral, rates
 
 
@@ -179,19 +255,23 @@ MODAL_PASS = _modal_pass.compiled
 
 
 @kernel(fastmath=REASSOCIATE)
-def _projected_laws(flat, delta, laws):
+def _projected_laws(values, columns, size, delta, laws):
     """[Phi]^T of the loads of the damper, the axial friction and the friction torque (rows of the result),
-    over the vertices in contact (delta > 0) of the dense rows ``flat`` of :func:`_modal_pass`."""
-    size = flat.shape[1]
-    projected = np.zeros((3, size))
+    over the vertices in contact (delta > 0) of the packed rows of :func:`_modal_pass`."""
+    rows_u, rows_v, rows_w, rows_t = values
+    damper_v, damper_w = np.zeros(columns[1].size), np.zeros(columns[2].size)
+    axial, torque = np.zeros(columns[0].size), np.zeros(columns[3].size)
     for i in range(delta.size):
         if delta[i] > 0.0:
-            base = 4 * i
-            damper_v, damper_w, axial, torque = laws[i, 1, 0], laws[i, 2, 0], laws[i, 0, 1], laws[i, 3, 2]
-            for j in range(size):
-                projected[0, j] += flat[base + 1, j] * damper_v + flat[base + 2, j] * damper_w
-                projected[1, j] += flat[base, j] * axial
-                projected[2, j] += flat[base + 3, j] * torque
+            _add_row(damper_v, rows_v, i, laws[i, 1, 0])
+            _add_row(damper_w, rows_w, i, laws[i, 2, 0])
+            _add_row(axial, rows_u, i, laws[i, 0, 1])
+            _add_row(torque, rows_t, i, laws[i, 3, 2])
+    projected = np.zeros((3, size))
+    _scatter(projected[0], columns[1], damper_v)
+    _scatter(projected[0], columns[2], damper_w)
+    _scatter(projected[1], columns[0], axial)
+    _scatter(projected[2], columns[3], torque)
     return projected
 
 
@@ -312,17 +392,19 @@ class ProjectedLaws(Mapping):
 
     NAMES = ("wall_damper", "wall_axial_friction", "wall_friction_torque")
 
-    def __init__(self, flat, delta: np.ndarray, loads: np.ndarray):
-        """``flat``: the rows of (u, v, w, theta_x) of the vertices evaluated, interleaved; ``delta``, ``loads``:
-        their indentations and the loads of each law (vertex, field, law)."""
-        self._flat, self._delta, self._loads, self._projected = flat, delta, loads, None
+    def __init__(self, vertex_set: "VertexSet", delta: np.ndarray, loads: np.ndarray):
+        """``vertex_set``: the vertices evaluated, with their rows; ``delta``, ``loads``: their indentations and the
+        loads of each law (vertex, field, law)."""
+        self._rows, self._delta, self._loads, self._projected = vertex_set, delta, loads, None
 
     def _laws(self) -> dict[str, np.ndarray]:
         if self._projected is None:
-            if sp.issparse(self._flat):
-                projected = np.asarray(self._flat.T @ self._loads.reshape(-1, len(self.NAMES))).T
+            rows = self._rows
+            if sp.issparse(rows.flat):
+                projected = np.asarray(rows.flat.T @ self._loads.reshape(-1, len(self.NAMES))).T
             else:
-                projected = _projected_laws(self._flat, self._delta, self._loads)
+                projected = _projected_laws(rows.packed.values, rows.packed.columns, rows.flat.shape[1],
+                                            self._delta, self._loads)
             self._projected = dict(zip(self.NAMES, projected))
         return self._projected
 
@@ -393,6 +475,7 @@ class VertexSet:
     vertices: np.ndarray
     lateral_rows: object  # (v, w) of each vertex, interleaved
     flat: object  # (u, v, w, theta_x) of each vertex, interleaved
+    packed: PackedRows | None  # the same, packed by field (a modal space's)
     q_ref: np.ndarray | None = None
     column_bound: np.ndarray | None = None
     reach: float = np.inf
@@ -435,7 +518,8 @@ class WallContact:
         # the rows of (v, w) alone, interleaved the same way: who touches the wall is known from these
         lateral = (len(FIELDS) * np.arange(n)[:, None] + np.array([1, 2])).ravel()
         lateral_rows = self.flat[lateral] if space.sparse else np.ascontiguousarray(self.flat[lateral])
-        self.every = VertexSet(np.arange(n), lateral_rows, self.flat)
+        self.every = VertexSet(np.arange(n), lateral_rows, self.flat,
+                               None if space.sparse else PackedRows.of(self.flat))
         # |P_i[:, j]|_1 of each vertex's (v, w) rows P_i: |(v, w)_i(q) - (v, w)_i(q_ref)| <= sum_j of it |dq_j|
         self._column_sizes = abs(lateral_rows[0::2]) + abs(lateral_rows[1::2])
         self.culling = culling
@@ -492,8 +576,9 @@ class WallContact:
         vertices = np.flatnonzero(~far)
         rows = (len(FIELDS) * vertices[:, None] + np.arange(len(FIELDS))).ravel()
         lateral = (2 * vertices[:, None] + np.arange(2)).ravel()
-        self._near = VertexSet(vertices, self.every.lateral_rows[lateral], self.flat[rows], q.copy(), column_bound,
-                               reach)
+        packed = None if self.every.packed is None else self.every.packed.at(vertices)
+        self._near = VertexSet(vertices, self.every.lateral_rows[lateral], self.flat[rows], packed, q.copy(),
+                               column_bound, reach)
         return self._near
 
     def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> WallForces:
@@ -507,15 +592,16 @@ class WallContact:
             delta, nodal, laws, potential = _vertex_loads(lateral, rates, *self._law())
             generalised = np.asarray(vertex_set.flat.T @ nodal.ravel())
         else:
-            delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(vertex_set.flat, q, qd,
-                                                                                     *self._law())
+            packed = vertex_set.packed
+            delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(
+                packed.values, packed.columns, q.size, q, qd, *self._law())
         return self.forces_of(vertex_set, (delta, nodal, laws, potential, generalised, lateral, rates), with_tangent)
 
     def forces_of(self, vertex_set: VertexSet, passed: tuple, with_tangent: bool) -> WallForces:
         """The evaluation of the vertices ``vertex_set`` from what :func:`_modal_pass` gives for them (also what a
         compiled Newton step hands back: solvers/compiled_step.py)."""
         delta, nodal, laws, potential, generalised, lateral, rates = passed
-        by_law = ProjectedLaws(vertex_set.flat, delta, laws)
+        by_law = ProjectedLaws(vertex_set, delta, laws)
         out = WallForces(generalised, potential, by_law, len(self.x), vertex_set.vertices, delta, nodal)
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
             out.tangent_data = (vertex_set.flat, lateral, rates)
@@ -527,14 +613,15 @@ class WallContact:
         return self._near if self.culling else self.every
 
     def kernel_data(self, vertex_set: VertexSet) -> tuple:
-        """(the dense rows of ``vertex_set``, the law's constants, and the bound that keeps it: its columns'
-        sizes, reference q and reach; none for every vertex) for
+        """(the packed rows of ``vertex_set`` as (values, columns), the law's constants, and the bound that keeps
+        it: its columns' sizes, reference q and reach; none for every vertex) for
         :func:`~fenics_drill.model.compiled_residual.residual_at`."""
         size = vertex_set.flat.shape[1]
         law = tuple(value if isinstance(value, bool) else float(value) for value in self._law())
+        rows = (vertex_set.packed.values, vertex_set.packed.columns)
         if vertex_set.q_ref is None:
-            return vertex_set.flat, law, np.zeros(size), np.zeros(size), np.inf
-        return vertex_set.flat, law, vertex_set.column_bound, vertex_set.q_ref, float(vertex_set.reach)
+            return rows, law, np.zeros(size), np.zeros(size), np.inf
+        return rows, law, vertex_set.column_bound, vertex_set.q_ref, float(vertex_set.reach)
 
     def tangent(self, forces: WallForces, c_u: float, c_v: float):
         """c_u d f/dq + c_v d f/dqd of the generalised wall force (None without contact):
