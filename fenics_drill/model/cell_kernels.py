@@ -20,6 +20,7 @@ from numba import njit, types
 from numba.extending import intrinsic
 
 from fenics_drill.model.compiled import REASSOCIATE, kernel
+from fenics_drill.model.packed_rows import NO_ROWS, add_row, gathered, scatter
 
 _FFI = cffi.FFI()
 
@@ -38,13 +39,16 @@ def _call_at(typingctx, address, element, coefficients, constants, coordinates, 
 
 
 @njit(cache=True, fastmath=set(REASSOCIATE))
-def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, basis, out):
+def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, basis, packed, out):
     """Add every cell's element tensor to ``out``: at the positions ``cell_dofs`` (a vector of ``size``, or
     with ``square`` a (size x size) matrix, row-major: the element matrix's rows are its test functions);
-    or, with a ``basis`` of N > 0 columns (the rows of [Phi] at the dofs), projected on it: P_c^T f_c, or
-    P_c^T K_c P_c (N x N) with P_c the basis rows of cell c's dofs, summed over the cells as one product of
-    the stacked P_c and K_c P_c (BLAS: three quarters of the work, 52 cells of the printed kinematics)."""
+    or, with a ``basis`` of N > 0 columns (the rows of [Phi] at the dofs), projected on it: P_c^T f_c (from
+    the rows ``packed`` by field, :mod:`~fenics_drill.model.packed_rows`), or P_c^T K_c P_c (N x N) with P_c
+    the basis rows of cell c's dofs, summed over the cells as one product of the stacked P_c and K_c P_c
+    (BLAS: three quarters of the work, 52 cells of the printed kinematics)."""
     n, modes = cell_dofs.shape[1], basis.shape[1]
+    values, field, columns, counts = packed
+    sums = np.zeros(columns.shape)  # P^T f on each field's columns
     element = np.empty(n * n if square else n)
     # a projected matrix: K_c P_c and P_c of every cell stacked, and P^T (K P) as one BLAS product at the end
     stacked = cell_dofs.shape[0] * n if square and modes > 0 else 0
@@ -70,10 +74,11 @@ def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, s
         else:
             for k in range(n):
                 value, row = element[k], cell_dofs[c, k]
-                for j in range(modes):
-                    out[j] += value * basis[row, j]
+                add_row(sums[field[row]], values, row, value, counts[field[row]])
     if stacked:  # sum over the cells of P_c^T (K_c P_c)
         out += np.dot(rows.T, weighted).ravel()
+    elif modes > 0 and not square:
+        scatter(out, columns, counts, sums)
 
 
 @njit(cache=True)
@@ -84,54 +89,62 @@ def _zeros_for(size, square, basis):
 
 
 @kernel
-def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, basis):
-    """The sum of the cells' element tensors (:func:`_add_cells`) from their packed coefficients."""
-    out = _zeros_for(size, square, basis)
-    _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, basis, out)
+def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, size, square):
+    """The sum of the cells' element tensors (:func:`_add_cells`) at their dofs from their packed coefficients."""
+    none = np.empty((size, 0))
+    out = _zeros_for(size, square, none)
+    _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, none, NO_ROWS, out)
     return out
 
 
 @njit(cache=True, fastmath=set(REASSOCIATE))
-def _packed_at(offset, rows, row_function, row_dof, state, basis):
+def _packed_at(offset, rows, row_function, row_dof, state, packed, modes):
     """The packed coefficients ``offset`` plus the functions' values at the dofs: entry ``rows[i]`` is the value
     of function ``row_function[i]`` (its reduced values are that slice of ``state``) at dof ``row_dof[i]``, row
-    ``row_dof[i]`` of ``basis`` times them."""
-    n = basis.shape[1]
-    functions = state.size // n  # one to three (U; U, V; U, V, A)
-    values = np.zeros((basis.shape[0], 3))  # (dofs, functions): one pass over the rows, the sums at a time
-    for d in range(basis.shape[0]):         # (BLAS is slower for so few columns)
+    ``row_dof[i]`` of the basis (``modes`` columns) times them; the rows packed by field
+    (:meth:`~fenics_drill.model.packed_rows.FieldPackedRows.kernel_data`) take a quarter of the dense rows'
+    products."""
+    values, field, columns, counts = packed
+    functions = state.size // modes  # one to three (U; U, V; U, V, A)
+    at = np.zeros((3,) + columns.shape)  # each function's reduced values at every field's columns
+    for f in range(functions):
+        at[f] = gathered(state[f * modes:(f + 1) * modes], columns)
+    dof_values = np.zeros((values.shape[0], 3))  # (dofs, functions): one pass over the rows, the sums at a time
+    for d in range(values.shape[0]):
+        g = field[d]
         u = v = a = 0.0
         if functions == 1:  # an energy of U alone: a third of the products
-            for j in range(n):
-                u += basis[d, j] * state[j]
+            for k in range(counts[g]):
+                u += values[d, k] * at[0, g, k]
         elif functions == 2:
-            for j in range(n):
-                b = basis[d, j]
-                u += b * state[j]
-                v += b * state[n + j]
+            for k in range(counts[g]):
+                b = values[d, k]
+                u += b * at[0, g, k]
+                v += b * at[1, g, k]
         else:
-            for j in range(n):
-                b = basis[d, j]
-                u += b * state[j]
-                v += b * state[n + j]
-                a += b * state[2 * n + j]
-        values[d, 0], values[d, 1], values[d, 2] = u, v, a
-    packed = offset.copy()
+            for k in range(counts[g]):
+                b = values[d, k]
+                u += b * at[0, g, k]
+                v += b * at[1, g, k]
+                a += b * at[2, g, k]
+        dof_values[d, 0], dof_values[d, 1], dof_values[d, 2] = u, v, a
+    out = offset.copy()
     for i in range(rows.size):
-        packed[rows[i]] += values[row_dof[i], row_function[i]]
-    return packed
+        out[rows[i]] += dof_values[row_dof[i], row_function[i]]
+    return out
 
 
 @kernel(fastmath=REASSOCIATE)
 def _assemble_cells_at(address, offset, rows, row_function, row_dof, state, constants, coordinates, cell_dofs, size,
-                       square, basis, projected):
+                       square, basis, packed, projected):
     """:func:`_assemble_cells` from the packed coefficients of :func:`_packed_at`, the result projected on
-    ``basis`` if ``projected`` (a vector or matrix), else summed as it is (a number)."""
-    packed = _packed_at(offset, rows, row_function, row_dof, state, basis)
+    ``basis`` if ``projected`` (a vector or matrix), else summed as it is (a number); ``packed``: the basis
+    packed by field."""
+    coefficients = _packed_at(offset, rows, row_function, row_dof, state, packed, basis.shape[1])
     projection = basis if projected else np.empty((basis.shape[0], 0))
     out = _zeros_for(size, square, projection)
-    _add_cells(address, packed.reshape(coordinates.shape[0], -1), constants, coordinates, cell_dofs, size, square,
-               projection, out)
+    _add_cells(address, coefficients.reshape(coordinates.shape[0], -1), constants, coordinates, cell_dofs, size,
+               square, projection, packed, out)
     return out
 
 
@@ -140,16 +153,17 @@ ASSEMBLE_CELLS_AT = _assemble_cells_at.compiled
 
 
 @kernel(fastmath=REASSOCIATE)
-def _functionals_at(address, offset, rows, row_function, row_dof, states, constants, coordinates, cell_dofs, basis):
+def _functionals_at(address, offset, rows, row_function, row_dof, states, constants, coordinates, cell_dofs, basis,
+                    packed):
     """A functional (a form of rank 0) at each row of ``states``, as :func:`_assemble_cells_at` gives it for one:
     one call for many states (the energies of a batch of accepted steps)."""
     out = np.empty(states.shape[0])
     none = np.empty((basis.shape[0], 0))
     for s in range(states.shape[0]):
-        packed = _packed_at(offset, rows, row_function, row_dof, states[s], basis)
+        coefficients = _packed_at(offset, rows, row_function, row_dof, states[s], packed, basis.shape[1])
         value = np.zeros(1)
-        _add_cells(address, packed.reshape(coordinates.shape[0], -1), constants, coordinates, cell_dofs, 1, False,
-                   none, value)
+        _add_cells(address, coefficients.reshape(coordinates.shape[0], -1), constants, coordinates, cell_dofs, 1, False,
+                   none, NO_ROWS, value)
         out[s] = value[0]
     return out
 
@@ -265,7 +279,7 @@ class CellAssembly:
         (cells x per cell)."""
         return self._shaped(_assemble_cells(self.address, np.ascontiguousarray(coefficients, dtype=float),
                                             self.constants, self.coordinates, self.cell_dofs, self.size,
-                                            self.rank == 2, np.empty((self.size, 0))))
+                                            self.rank == 2))
 
     def element_tensors(self, coefficients: np.ndarray) -> np.ndarray:
         """Each cell's element tensor (cells x its size: 1, the cell's dofs, or their square, row-major) from
@@ -275,18 +289,19 @@ class CellAssembly:
         packed = np.ascontiguousarray(coefficients, dtype=float).reshape(len(self.coordinates), -1)
         return _tabulate_cells(self.address, packed, self.constants, self.coordinates, size)
 
-    def projected(self, offset, rows, row_function, row_dof, state, basis):
+    def projected(self, offset, rows, row_function, row_dof, state, basis, packed):
         """The number, or the vector or matrix projected on ``basis`` (the rows of [Phi] at the dofs:
         P^T f, P^T K P), from the packed coefficients ``offset`` plus, at ``rows``, the values at the dofs
         ``row_dof`` of the functions ``row_function`` whose reduced values ``state`` stacks (the placement
-        of :class:`~fenics_drill.model.internal_force.SampledCoefficients`)."""
+        of :class:`~fenics_drill.model.internal_force.SampledCoefficients`); ``packed``: the basis packed by
+        field (:meth:`~fenics_drill.model.packed_rows.FieldPackedRows.kernel_data`)."""
         return self._shaped(_assemble_cells_at(self.address, offset, rows, row_function, row_dof, state,
                                                self.constants, self.coordinates, self.cell_dofs, self.size,
-                                               self.rank == 2, basis, self.rank > 0))
+                                               self.rank == 2, basis, packed, self.rank > 0))
 
-    def functionals(self, offset, rows, row_function, row_dof, states, basis) -> np.ndarray:
+    def functionals(self, offset, rows, row_function, row_dof, states, basis, packed) -> np.ndarray:
         """A functional's value at each row of ``states`` (:meth:`projected` of each, in one call)."""
         if self.rank != 0:
             raise ValueError("functionals() takes a form of rank 0")
         return _functionals_at(self.address, offset, rows, row_function, row_dof, np.ascontiguousarray(states),
-                               self.constants, self.coordinates, self.cell_dofs, basis)
+                               self.constants, self.coordinates, self.cell_dofs, basis, packed)

@@ -25,6 +25,7 @@ from fenics_drill.model.forces.wall_contact import MODAL_PASS as WALL_PASS
 from fenics_drill.model.forces.wall_contact import WallContact
 from fenics_drill.model.internal_force import AssembledInternalForce
 from fenics_drill.model.out_of_band_damping import OutOfBandDamping
+from fenics_drill.model.packed_rows import NO_ROWS
 
 #: The kinds of point force :func:`residual_at` sums, in the order of the model's list.
 GRAVITY, WALL, BIT_ROCK, DAMPING = 0, 1, 2, 3
@@ -39,11 +40,11 @@ NO_BIT = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 def _internal_force(internal, q, qd, qdd):
     """:meth:`AssembledInternalForce.evaluate` of a modal space: [K C M] (q, qd, qdd) plus the sampled
     remainder (a sample), or the cells' force alone (all cells)."""
-    sampled, linear_rows, offset, rows, row_function, row_dof, basis, address, constants, coordinates, cell_dofs, \
-        size = internal
+    sampled, linear_rows, offset, rows, row_function, row_dof, basis, packed, address, constants, coordinates, \
+        cell_dofs, size = internal
     state = np.concatenate((q, qd, qdd))
     cells = ASSEMBLE_CELLS_AT(address, offset, rows, row_function, row_dof, state, constants, coordinates,
-                               cell_dofs, size, False, basis, True)
+                               cell_dofs, size, False, basis, packed, True)
     if not sampled:
         return cells
     return np.dot(linear_rows, state) + cells
@@ -55,7 +56,7 @@ def residual_at(internal, forces, order, constraints, drive_loads, q, qd, qdd, m
     what the wall's pass and the bit law gave (for the step's evaluation object), and whether q is still within
     the bound of the wall's culled vertices (False: the evaluation is not the model's, which would cull anew).
 
-    ``forces``: (gravity load, wall rows (packed: values, columns), wall law, culling bound, reference q, reach,
+    ``forces``: (gravity load, wall rows (packed: FieldPackedRows.kernel_data), wall law, culling bound, reference q, reach,
     bit rows, bit unit loads, bit law constants, damping matrix); ``order``: the kinds of the model's forces in its order; ``drive_loads``:
     the drive's generalised loads, the same at every state (:meth:`~fenics_drill.model.top_drive.TopDrive.
     constant_loads`)."""
@@ -69,8 +70,8 @@ def residual_at(internal, forces, order, constraints, drive_loads, q, qd, qdd, m
             external += gravity
         elif kind == WALL:
             within = np.dot(column_bound, np.abs(q - q_ref)) < reach
-            wall = WALL_PASS(wall_rows[0], wall_rows[1], q.size, q, qd, law[0], law[1], law[2], law[3], law[4], law[5],
-                             law[6], law[7], law[8])
+            wall = WALL_PASS(wall_rows, q.size, q, qd, law[0], law[1], law[2], law[3], law[4], law[5], law[6], law[7],
+                             law[8])
             external += wall[4]
         elif kind == BIT_ROCK:
             rates = np.dot(bit_rows, qd)
@@ -119,9 +120,8 @@ class CompiledResidual:
         size = self.model.size
         gravity, bit, damping = (self.model.force(name) for name in (Gravity.name, BitRock.name,
                                                                     OutOfBandDamping.name))
-        no_rows = ((np.empty((0, 0)),) * 4, (np.empty(0, dtype=np.int64),) * 4)
         wall = (self.wall.kernel_data(vertices) if self.wall is not None else
-                (no_rows, (0.0,) * 4 + (False,) + (0.0,) * 4, np.zeros(size), np.zeros(size), np.inf))
+                (NO_ROWS, (0.0,) * 4 + (False,) + (0.0,) * 4, np.zeros(size), np.zeros(size), np.inf))
         bit_data = bit.kernel_data() if bit is not None else (np.empty((2, size)), np.empty((2, size)), (0.0,) * 4)
         return (np.zeros(size) if gravity is None else gravity.load, *wall, *bit_data,
                 np.empty((0, size)) if damping is None else damping.damping)

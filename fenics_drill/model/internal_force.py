@@ -30,6 +30,7 @@ from fenics_drill.forms import energies
 from fenics_drill.model.cell_kernels import CellAssembly
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.operators import LinearOperators
+from fenics_drill.model.packed_rows import FieldPackedRows
 
 
 def quadratic_forms(matrix: np.ndarray, rows: np.ndarray) -> np.ndarray:
@@ -158,6 +159,7 @@ class AssembledInternalForce:
                  geometric_nonlinearity: bool, inertial_nonlinearity: bool, kinematics: str = "objective",
                  angular_velocity: str = "consistent", sample: ElementSample | None = None):
         self.space, self.sample = space, sample
+        self._field_of_dof = disc.field_of_dof
         self.switches = (geometric_nonlinearity, inertial_nonlinearity, kinematics, angular_velocity)
         forms = InternalForms.of(disc, self.switches, sample is not None)
         self.U, self.V, self.A = forms.functions
@@ -189,7 +191,7 @@ class AssembledInternalForce:
             self.weight.x.array[:] = 0.0
             self.weight.x.array[cells] = self.sample.weights
         return SampledCoefficients(form, functions, dofs, self.space.phi if self.sample is None else self.phi_rows,
-                                   cells)
+                                   cells, self._field_of_dof[dofs])
 
     # the cells' kernels of the forms, built on first use (a trainer of a sample assembles through DOLFINx and
     # never needs them)
@@ -235,15 +237,15 @@ class AssembledInternalForce:
     def kernel_data(self) -> tuple | None:
         """What :func:`~fenics_drill.model.compiled_residual.residual_at` needs to evaluate this force as
         :meth:`evaluate` does: (sampled, [K C M] or an empty matrix, the packed coefficients' placement, the
-        basis rows, and the residual kernel's address, constants, coordinates, cell dofs and size); None in
+        basis rows, dense and packed by field, and the residual kernel's address, constants, coordinates, cell dofs and size); None in
         the full space."""
         if self._kernel_cells is None:
             return None
         packing, sampled = self._packing, self.sample is not None
         cells = packing.cells
         return (sampled, self._linear_rows if sampled else np.empty((0, 0)), packing.offset, packing.rows,
-                packing.row_function, packing.row_dof, packing.basis, cells.address, cells.constants,
-                cells.coordinates, cells.cell_dofs, cells.size)
+                packing.row_function, packing.row_dof, packing.basis, packing.packed_basis, cells.address,
+                cells.constants, cells.coordinates, cells.cell_dofs, cells.size)
 
     def evaluate(self, q, qd, qdd) -> np.ndarray:
         self._state = (q, qd, qdd)
@@ -321,8 +323,10 @@ class SampledCoefficients:
     kernels (:class:`~fenics_drill.model.cell_kernels.CellAssembly`), without setting the functions or
     DOLFINx's packing and assembly paths."""
 
-    def __init__(self, form: fem.Form, functions, dofs: np.ndarray, phi_rows: np.ndarray, cells: np.ndarray):
-        """``cells``: the sample (the form is integrated over all cells: its packing is read at these)."""
+    def __init__(self, form: fem.Form, functions, dofs: np.ndarray, phi_rows: np.ndarray, cells: np.ndarray,
+                 fields: np.ndarray):
+        """``cells``: the sample (the form is integrated over all cells: its packing is read at these);
+        ``fields``: the field of each dof (the rows are packed by it: :mod:`~fenics_drill.model.packed_rows`)."""
         for function in functions:
             function.x.array[:] = 0.0
         (key, packed), = fem.pack_coefficients(form).items()
@@ -347,6 +351,7 @@ class SampledCoefficients:
         if np.unique(self.rows).size != self.rows.size:
             raise ValueError("a packed coefficient depends on more than one function")
         self.basis = np.ascontiguousarray(phi_rows)
+        self.packed_basis = FieldPackedRows.of(self.basis, fields).kernel_data()
         self.cells = CellAssembly(form, dofs, cells)
         # a packed entry that is not one dof's value as it is (a scaled or combined dof) would be misplaced:
         # the placement must give DOLFINx's own packing at a random state
@@ -375,11 +380,13 @@ class SampledCoefficients:
     def assemble(self, state: np.ndarray):
         """The assembled number, or the vector or matrix projected on [Phi] (cell by cell), at the reduced
         state of the functions stacked in one vector."""
-        return self.cells.projected(self.offset, self.rows, self.row_function, self.row_dof, state, self.basis)
+        return self.cells.projected(self.offset, self.rows, self.row_function, self.row_dof, state, self.basis,
+                                    self.packed_basis)
 
     def assemble_rows(self, states: np.ndarray) -> np.ndarray:
         """The assembled number of a functional (an energy) at each row of ``states``, in one call."""
-        return self.cells.functionals(self.offset, self.rows, self.row_function, self.row_dof, states, self.basis)
+        return self.cells.functionals(self.offset, self.rows, self.row_function, self.row_dof, states, self.basis,
+                                      self.packed_basis)
 
 
 class TangentEntries:

@@ -27,6 +27,7 @@ from fenics_drill.model.discretization import V as V_FIELD
 from fenics_drill.model.discretization import W as W_FIELD
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
+from fenics_drill.model.packed_rows import FieldPackedRows, add_row, dot_row, dot_row_twice, gathered, scatter
 from fenics_drill.scene import LAW_SIGN
 
 FIELDS = (U_FIELD, V_FIELD, W_FIELD, TX_FIELD)  # the fields the wall acts on: F_a, F_v, F_w, T_FS
@@ -148,105 +149,40 @@ def _vertex_loads(lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_to
     return delta, nodal, laws, potential
 
 
-@dataclass(frozen=True)
-class PackedRows:
-    """The rows of [Phi] of each field of FIELDS at some vertices, each on the columns where that field's rows
-    are nonzero.  The modes of the straight string move one group of fields each (model/modes.py), so a
-    field's rows are nonzero on a fraction of the columns: on the paper scene's basis u, v, w and theta_x
-    have 13, 11, 14 and 27 of 62, and a pass over them reads a quarter of the dense rows.  Each field's
-    columns are padded with zeros to a multiple of PADDING, which spares the vectorised loops their
-    remainders (the wall's pass took 26 us against 28-29 us unpadded)."""
-
-    values: tuple  # per field, (vertices, its columns)
-    columns: tuple  # per field, its columns (int64; a padding column is column 0, with zero rows)
-
-    PADDING: ClassVar[int] = 4
-
-    @classmethod
-    def of(cls, flat: np.ndarray) -> "PackedRows":
-        """The packed form of the dense rows ``flat`` ((u, v, w, theta_x) of each vertex, interleaved)."""
-        values, columns = [], []
-        for rows in (flat[f::len(FIELDS)] for f in range(len(FIELDS))):
-            nonzero = np.flatnonzero(np.any(rows != 0.0, axis=0))
-            padded = -(-nonzero.size // cls.PADDING) * cls.PADDING
-            columns.append(np.zeros(padded, dtype=np.int64))
-            columns[-1][:nonzero.size] = nonzero
-            values.append(np.zeros((rows.shape[0], padded)))
-            values[-1][:, :nonzero.size] = rows[:, nonzero]
-        return cls(tuple(values), tuple(columns))
-
-    def at(self, vertices: np.ndarray) -> "PackedRows":
-        """The rows of some of the vertices (indices into these)."""
-        return PackedRows(tuple(np.ascontiguousarray(rows[vertices]) for rows in self.values), self.columns)
-
-
-@njit(cache=True, inline="always")
-def _dot_row(rows, i, x):
-    """rows[i] . x, without a view of the row."""
-    s = 0.0
-    for j in range(x.size):
-        s += rows[i, j] * x[j]
-    return s
-
-
-@njit(cache=True, inline="always")
-def _dot_row_twice(rows, i, x, y):
-    """(rows[i] . x, rows[i] . y), reading the row once."""
-    s = t = 0.0
-    for j in range(x.size):
-        s += rows[i, j] * x[j]
-        t += rows[i, j] * y[j]
-    return s, t
-
-
-@njit(cache=True, inline="always")
-def _add_row(out, rows, i, factor):
-    """out += factor rows[i], without a view of the row."""
-    for j in range(out.size):
-        out[j] += factor * rows[i, j]
-
-
-@njit(cache=True, inline="always")
-def _scatter(out, columns, packed):
-    """out[columns] += packed."""
-    for j in range(columns.size):
-        out[columns[j]] += packed[j]
-
-
 @kernel(fastmath=REASSOCIATE)
-def _modal_pass(values, columns, size, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s):
-    """:func:`_vertex_loads` in a modal space (``size`` coordinates), in one pass over the rows of [Phi] packed by
-    field (:class:`PackedRows` ``values``, ``columns``): each vertex's positions and rates, its law, and [Phi]^T
-    of its nodal loads, while its rows are in cache.  Also returns the positions and rates.  The split by law
-    is left to :func:`_projected_laws` (the budget reads it at accepted steps only: in the pass it cost a
-    sixth of the pass at every Newton iterate)."""
-    rows_u, rows_v, rows_w, rows_t = values
-    n = rows_u.shape[0]
-    q_v, q_w = q[columns[1]], q[columns[2]]
-    qd_u, qd_v, qd_w, qd_t = qd[columns[0]], qd[columns[1]], qd[columns[2]], qd[columns[3]]
-    load_u, load_v, load_w, load_t = (np.zeros(columns[0].size), np.zeros(columns[1].size),
-                                      np.zeros(columns[2].size), np.zeros(columns[3].size))
+def _modal_pass(packed, size, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s):
+    """:func:`_vertex_loads` in a modal space (``size`` coordinates), in one pass over the rows of [Phi] of
+    (u, v, w, theta_x) at each vertex, interleaved and packed by field (``packed``: :meth:`~fenics_drill.model.
+    packed_rows.FieldPackedRows.kernel_data`, groups in the order of FIELDS): each vertex's positions and
+    rates, its law, and [Phi]^T of its nodal loads, while its rows are in cache.  Also returns the positions
+    and rates.  The split by law is left to :func:`_projected_laws` (the budget reads it at accepted steps
+    only: in the pass it cost a sixth of the pass at every Newton iterate)."""
+    values, _, columns, counts = packed
+    n = values.shape[0] // 4
+    q_at, qd_at = gathered(q, columns), gathered(qd, columns)
+    q_v, q_w, qd_u, qd_v, qd_w, qd_t = q_at[1], q_at[2], qd_at[0], qd_at[1], qd_at[2], qd_at[3]
+    c_u, c_v, c_w, c_t = counts[0], counts[1], counts[2], counts[3]
+    loads = np.zeros(columns.shape)
+    load_u, load_v, load_w, load_t = loads[0], loads[1], loads[2], loads[3]
     delta, nodal, laws = np.empty(n), np.zeros((n, 4)), np.zeros((n, 4, 3))
     lateral, rates = np.empty((n, 2)), np.empty((n, 4))
     potential = 0.0
     for i in range(n):
-        v, rate_v = _dot_row_twice(rows_v, i, q_v, qd_v)
-        w, rate_w = _dot_row_twice(rows_w, i, q_w, qd_w)
+        r = 4 * i
+        v, rate_v = dot_row_twice(values, r + 1, q_v, qd_v, c_v)
+        w, rate_w = dot_row_twice(values, r + 2, q_w, qd_w, c_w)
         lateral[i, 0], lateral[i, 1] = v, w
-        rates[i, 0], rates[i, 1], rates[i, 2], rates[i, 3] = _dot_row(rows_u, i, qd_u), rate_v, rate_w, _dot_row(
-            rows_t, i, qd_t)
+        rates[i, 0], rates[i, 1] = dot_row(values, r, qd_u, c_u), rate_v
+        rates[i, 2], rates[i, 3] = rate_w, dot_row(values, r + 3, qd_t, c_t)
         potential += _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh,
                                  v_s, delta, nodal, laws)
         if delta[i] > 0.0:
-            _add_row(load_u, rows_u, i, nodal[i, 0])
-            _add_row(load_v, rows_v, i, nodal[i, 1])
-            _add_row(load_w, rows_w, i, nodal[i, 2])
-            _add_row(load_t, rows_t, i, nodal[i, 3])
+            add_row(load_u, values, r, nodal[i, 0], c_u)
+            add_row(load_v, values, r + 1, nodal[i, 1], c_v)
+            add_row(load_w, values, r + 2, nodal[i, 2], c_w)
+            add_row(load_t, values, r + 3, nodal[i, 3], c_t)
     generalised = np.zeros(size)
-    _scatter(generalised, columns[0], load_u)
-    _scatter(generalised, columns[1], load_v)
-    _scatter(generalised, columns[2], load_w)
-    _scatter(generalised, columns[3], load_t)
+    scatter(generalised, columns, counts, loads)
     return delta, nodal, laws, potential, generalised, lateral, rates
 
 
@@ -255,23 +191,21 @@ MODAL_PASS = _modal_pass.compiled
 
 
 @kernel(fastmath=REASSOCIATE)
-def _projected_laws(values, columns, size, delta, laws):
+def _projected_laws(packed, size, delta, laws):
     """[Phi]^T of the loads of the damper, the axial friction and the friction torque (rows of the result),
     over the vertices in contact (delta > 0) of the packed rows of :func:`_modal_pass`."""
-    rows_u, rows_v, rows_w, rows_t = values
-    damper_v, damper_w = np.zeros(columns[1].size), np.zeros(columns[2].size)
-    axial, torque = np.zeros(columns[0].size), np.zeros(columns[3].size)
+    values, _, columns, counts = packed
+    by_law = np.zeros((3,) + columns.shape)  # each law's packed sums, by field
     for i in range(delta.size):
         if delta[i] > 0.0:
-            _add_row(damper_v, rows_v, i, laws[i, 1, 0])
-            _add_row(damper_w, rows_w, i, laws[i, 2, 0])
-            _add_row(axial, rows_u, i, laws[i, 0, 1])
-            _add_row(torque, rows_t, i, laws[i, 3, 2])
+            r = 4 * i
+            add_row(by_law[0, 1], values, r + 1, laws[i, 1, 0], counts[1])
+            add_row(by_law[0, 2], values, r + 2, laws[i, 2, 0], counts[2])
+            add_row(by_law[1, 0], values, r, laws[i, 0, 1], counts[0])
+            add_row(by_law[2, 3], values, r + 3, laws[i, 3, 2], counts[3])
     projected = np.zeros((3, size))
-    _scatter(projected[0], columns[1], damper_v)
-    _scatter(projected[0], columns[2], damper_w)
-    _scatter(projected[1], columns[0], axial)
-    _scatter(projected[2], columns[3], torque)
+    for law in range(3):
+        scatter(projected[law], columns, counts, by_law[law])
     return projected
 
 
@@ -403,8 +337,8 @@ class ProjectedLaws(Mapping):
             if sp.issparse(rows.flat):
                 projected = np.asarray(rows.flat.T @ self._loads.reshape(-1, len(self.NAMES))).T
             else:
-                projected = _projected_laws(rows.packed.values, rows.packed.columns, rows.flat.shape[1],
-                                            self._delta, self._loads)
+                projected = _projected_laws(rows.packed.kernel_data(), rows.flat.shape[1], self._delta,
+                                            self._loads)
             self._projected = dict(zip(self.NAMES, projected))
         return self._projected
 
@@ -475,7 +409,7 @@ class VertexSet:
     vertices: np.ndarray
     lateral_rows: object  # (v, w) of each vertex, interleaved
     flat: object  # (u, v, w, theta_x) of each vertex, interleaved
-    packed: PackedRows | None  # the same, packed by field (a modal space's)
+    packed: FieldPackedRows | None  # the same, packed by field (a modal space's)
     q_ref: np.ndarray | None = None
     column_bound: np.ndarray | None = None
     reach: float = np.inf
@@ -519,7 +453,7 @@ class WallContact:
         lateral = (len(FIELDS) * np.arange(n)[:, None] + np.array([1, 2])).ravel()
         lateral_rows = self.flat[lateral] if space.sparse else np.ascontiguousarray(self.flat[lateral])
         self.every = VertexSet(np.arange(n), lateral_rows, self.flat,
-                               None if space.sparse else PackedRows.of(self.flat))
+                               None if space.sparse else FieldPackedRows.of(self.flat, np.tile(np.arange(len(FIELDS)), n)))
         # |P_i[:, j]|_1 of each vertex's (v, w) rows P_i: |(v, w)_i(q) - (v, w)_i(q_ref)| <= sum_j of it |dq_j|
         self._column_sizes = abs(lateral_rows[0::2]) + abs(lateral_rows[1::2])
         self.culling = culling
@@ -576,7 +510,7 @@ class WallContact:
         vertices = np.flatnonzero(~far)
         rows = (len(FIELDS) * vertices[:, None] + np.arange(len(FIELDS))).ravel()
         lateral = (2 * vertices[:, None] + np.arange(2)).ravel()
-        packed = None if self.every.packed is None else self.every.packed.at(vertices)
+        packed = None if self.every.packed is None else self.every.packed.at(rows)
         self._near = VertexSet(vertices, self.every.lateral_rows[lateral], self.flat[rows], packed, q.copy(),
                                column_bound, reach)
         return self._near
@@ -592,9 +526,8 @@ class WallContact:
             delta, nodal, laws, potential = _vertex_loads(lateral, rates, *self._law())
             generalised = np.asarray(vertex_set.flat.T @ nodal.ravel())
         else:
-            packed = vertex_set.packed
             delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(
-                packed.values, packed.columns, q.size, q, qd, *self._law())
+                vertex_set.packed.kernel_data(), q.size, q, qd, *self._law())
         return self.forces_of(vertex_set, (delta, nodal, laws, potential, generalised, lateral, rates), with_tangent)
 
     def forces_of(self, vertex_set: VertexSet, passed: tuple, with_tangent: bool) -> WallForces:
@@ -613,12 +546,12 @@ class WallContact:
         return self._near if self.culling else self.every
 
     def kernel_data(self, vertex_set: VertexSet) -> tuple:
-        """(the packed rows of ``vertex_set`` as (values, columns), the law's constants, and the bound that keeps
-        it: its columns' sizes, reference q and reach; none for every vertex) for
+        """(the packed rows of ``vertex_set``, the law's constants, and the bound that keeps it: its columns'
+        sizes, reference q and reach; none for every vertex) for
         :func:`~fenics_drill.model.compiled_residual.residual_at`."""
         size = vertex_set.flat.shape[1]
         law = tuple(value if isinstance(value, bool) else float(value) for value in self._law())
-        rows = (vertex_set.packed.values, vertex_set.packed.columns)
+        rows = vertex_set.packed.kernel_data()
         if vertex_set.q_ref is None:
             return rows, law, np.zeros(size), np.zeros(size), np.inf
         return rows, law, vertex_set.column_bound, vertex_set.q_ref, float(vertex_set.reach)
