@@ -39,15 +39,15 @@ def _call_at(typingctx, address, element, coefficients, constants, coordinates, 
 
 
 @njit(cache=True, fastmath=set(REASSOCIATE))
-def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, basis, packed, out):
+def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, basis, basis_by_field, out):
     """Add every cell's element tensor to ``out``: at the positions ``cell_dofs`` (a vector of ``size``, or
     with ``square`` a (size x size) matrix, row-major: the element matrix's rows are its test functions);
     or, with a ``basis`` of N > 0 columns (the rows of [Phi] at the dofs), projected on it: P_c^T f_c (from
-    the rows ``packed`` by field, :mod:`~fenics_drill.model.packed_rows`), or P_c^T K_c P_c (N x N) with P_c
-    the basis rows of cell c's dofs, summed over the cells as one product of the stacked P_c and K_c P_c
-    (BLAS: three quarters of the work, 52 cells of the printed kinematics)."""
+    the same rows packed by field, ``basis_by_field``: :mod:`~fenics_drill.model.packed_rows`), or
+    P_c^T K_c P_c (N x N) with P_c the basis rows of cell c's dofs, summed over the cells as one product of
+    the stacked P_c and K_c P_c (BLAS: three quarters of the work, 52 cells of the printed kinematics)."""
     n, modes = cell_dofs.shape[1], basis.shape[1]
-    values, field, columns, counts = packed
+    values, field, columns, counts = basis_by_field
     sums = np.zeros(columns.shape)  # P^T f on each field's columns
     element = np.empty(n * n if square else n)
     # a projected matrix: K_c P_c and P_c of every cell stacked, and P^T (K P) as one BLAS product at the end
@@ -98,13 +98,13 @@ def _assemble_cells(address, coefficients, constants, coordinates, cell_dofs, si
 
 
 @njit(cache=True, fastmath=set(REASSOCIATE))
-def _packed_at(offset, rows, row_function, row_dof, state, packed, modes):
+def _packed_at(offset, rows, row_function, row_dof, state, basis_by_field, modes):
     """The packed coefficients ``offset`` plus the functions' values at the dofs: entry ``rows[i]`` is the value
     of function ``row_function[i]`` (its reduced values are that slice of ``state``) at dof ``row_dof[i]``, row
-    ``row_dof[i]`` of the basis (``modes`` columns) times them; the rows packed by field
-    (:meth:`~fenics_drill.model.packed_rows.FieldPackedRows.kernel_data`) take a quarter of the dense rows'
+    ``row_dof[i]`` of the basis (``modes`` columns) times them; the rows packed by field, ``basis_by_field``
+    (:meth:`~fenics_drill.model.packed_rows.FieldPackedRows.kernel_data`), take a quarter of the dense rows'
     products."""
-    values, field, columns, counts = packed
+    values, field, columns, counts = basis_by_field
     functions = state.size // modes  # one to three (U; U, V; U, V, A)
     at = np.zeros((3,) + columns.shape)  # each function's reduced values at every field's columns
     for f in range(functions):
@@ -136,15 +136,15 @@ def _packed_at(offset, rows, row_function, row_dof, state, packed, modes):
 
 @kernel(fastmath=REASSOCIATE)
 def _assemble_cells_at(address, offset, rows, row_function, row_dof, state, constants, coordinates, cell_dofs, size,
-                       square, basis, packed, projected):
+                       square, basis, basis_by_field, projected):
     """:func:`_assemble_cells` from the packed coefficients of :func:`_packed_at`, the result projected on
-    ``basis`` if ``projected`` (a vector or matrix), else summed as it is (a number); ``packed``: the basis
-    packed by field."""
-    coefficients = _packed_at(offset, rows, row_function, row_dof, state, packed, basis.shape[1])
+    ``basis`` if ``projected`` (a vector or matrix), else summed as it is (a number); ``basis_by_field``: the
+    basis packed by field."""
+    coefficients = _packed_at(offset, rows, row_function, row_dof, state, basis_by_field, basis.shape[1])
     projection = basis if projected else np.empty((basis.shape[0], 0))
     out = _zeros_for(size, square, projection)
     _add_cells(address, coefficients.reshape(coordinates.shape[0], -1), constants, coordinates, cell_dofs, size,
-               square, projection, packed, out)
+               square, projection, basis_by_field, out)
     return out
 
 
@@ -154,13 +154,13 @@ ASSEMBLE_CELLS_AT = _assemble_cells_at.compiled
 
 @kernel(fastmath=REASSOCIATE)
 def _functionals_at(address, offset, rows, row_function, row_dof, states, constants, coordinates, cell_dofs, basis,
-                    packed):
+                    basis_by_field):
     """A functional (a form of rank 0) at each row of ``states``, as :func:`_assemble_cells_at` gives it for one:
     one call for many states (the energies of a batch of accepted steps)."""
     out = np.empty(states.shape[0])
     none = np.empty((basis.shape[0], 0))
     for s in range(states.shape[0]):
-        coefficients = _packed_at(offset, rows, row_function, row_dof, states[s], packed, basis.shape[1])
+        coefficients = _packed_at(offset, rows, row_function, row_dof, states[s], basis_by_field, basis.shape[1])
         value = np.zeros(1)
         _add_cells(address, coefficients.reshape(coordinates.shape[0], -1), constants, coordinates, cell_dofs, 1, False,
                    none, NO_ROWS, value)
@@ -289,19 +289,19 @@ class CellAssembly:
         packed = np.ascontiguousarray(coefficients, dtype=float).reshape(len(self.coordinates), -1)
         return _tabulate_cells(self.address, packed, self.constants, self.coordinates, size)
 
-    def projected(self, offset, rows, row_function, row_dof, state, basis, packed):
+    def projected(self, offset, rows, row_function, row_dof, state, basis, basis_by_field):
         """The number, or the vector or matrix projected on ``basis`` (the rows of [Phi] at the dofs:
         P^T f, P^T K P), from the packed coefficients ``offset`` plus, at ``rows``, the values at the dofs
         ``row_dof`` of the functions ``row_function`` whose reduced values ``state`` stacks (the placement
-        of :class:`~fenics_drill.model.internal_force.SampledCoefficients`); ``packed``: the basis packed by
-        field (:meth:`~fenics_drill.model.packed_rows.FieldPackedRows.kernel_data`)."""
+        of :class:`~fenics_drill.model.internal_force.SampledCoefficients`); ``basis_by_field``: the basis packed
+        by field (:meth:`~fenics_drill.model.packed_rows.FieldPackedRows.kernel_data`)."""
         return self._shaped(_assemble_cells_at(self.address, offset, rows, row_function, row_dof, state,
                                                self.constants, self.coordinates, self.cell_dofs, self.size,
-                                               self.rank == 2, basis, packed, self.rank > 0))
+                                               self.rank == 2, basis, basis_by_field, self.rank > 0))
 
-    def functionals(self, offset, rows, row_function, row_dof, states, basis, packed) -> np.ndarray:
+    def functionals(self, offset, rows, row_function, row_dof, states, basis, basis_by_field) -> np.ndarray:
         """A functional's value at each row of ``states`` (:meth:`projected` of each, in one call)."""
         if self.rank != 0:
             raise ValueError("functionals() takes a form of rank 0")
         return _functionals_at(self.address, offset, rows, row_function, row_dof, np.ascontiguousarray(states),
-                               self.constants, self.coordinates, self.cell_dofs, basis, packed)
+                               self.constants, self.coordinates, self.cell_dofs, basis, basis_by_field)

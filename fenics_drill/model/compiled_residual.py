@@ -40,11 +40,11 @@ NO_BIT = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 def _internal_force(internal, q, qd, qdd):
     """:meth:`AssembledInternalForce.evaluate` of a modal space: [K C M] (q, qd, qdd) plus the sampled
     remainder (a sample), or the cells' force alone (all cells)."""
-    sampled, linear_rows, offset, rows, row_function, row_dof, basis, packed, address, constants, coordinates, \
-        cell_dofs, size = internal
+    sampled, linear_rows, offset, rows, row_function, row_dof, basis, basis_by_field, address, constants, \
+        coordinates, cell_dofs, size = internal
     state = np.concatenate((q, qd, qdd))
     cells = ASSEMBLE_CELLS_AT(address, offset, rows, row_function, row_dof, state, constants, coordinates,
-                               cell_dofs, size, False, basis, packed, True)
+                               cell_dofs, size, False, basis, basis_by_field, True)
     if not sampled:
         return cells
     return np.dot(linear_rows, state) + cells
@@ -56,10 +56,10 @@ def residual_at(internal, forces, order, constraints, drive_loads, q, qd, qdd, m
     what the wall's pass and the bit law gave (for the step's evaluation object), and whether q is still within
     the bound of the wall's culled vertices (False: the evaluation is not the model's, which would cull anew).
 
-    ``forces``: (gravity load, wall rows (packed: FieldPackedRows.kernel_data), wall law, culling bound, reference q, reach,
-    bit rows, bit unit loads, bit law constants, damping matrix); ``order``: the kinds of the model's forces in its order; ``drive_loads``:
-    the drive's generalised loads, the same at every state (:meth:`~fenics_drill.model.top_drive.TopDrive.
-    constant_loads`)."""
+    ``forces``: (gravity load, wall rows (packed by field: FieldPackedRows.kernel_data), wall law, culling
+    bound, reference q, reach, bit rows, bit unit loads, bit law constants, damping matrix); ``order``: the kinds
+    of the model's forces in its order; ``drive_loads``: the drive's generalised loads, the same at every state
+    (:meth:`~fenics_drill.model.top_drive.TopDrive.constant_loads`)."""
     gravity, wall_rows, law, column_bound, q_ref, reach, bit_rows, bit_units, bit_law, damping = forces
     internal_force = _internal_force(internal, q, qd, qdd)
     external = drive_loads.copy()

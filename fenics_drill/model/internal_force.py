@@ -237,14 +237,14 @@ class AssembledInternalForce:
     def kernel_data(self) -> tuple | None:
         """What :func:`~fenics_drill.model.compiled_residual.residual_at` needs to evaluate this force as
         :meth:`evaluate` does: (sampled, [K C M] or an empty matrix, the packed coefficients' placement, the
-        basis rows, dense and packed by field, and the residual kernel's address, constants, coordinates, cell dofs and size); None in
-        the full space."""
+        basis rows, dense and packed by field, and the residual kernel's address, constants, coordinates, cell
+        dofs and size); None in the full space."""
         if self._kernel_cells is None:
             return None
         packing, sampled = self._packing, self.sample is not None
         cells = packing.cells
         return (sampled, self._linear_rows if sampled else np.empty((0, 0)), packing.offset, packing.rows,
-                packing.row_function, packing.row_dof, packing.basis, packing.packed_basis, cells.address,
+                packing.row_function, packing.row_dof, packing.basis, packing.basis_by_field, cells.address,
                 cells.constants, cells.coordinates, cells.cell_dofs, cells.size)
 
     def evaluate(self, q, qd, qdd) -> np.ndarray:
@@ -351,7 +351,7 @@ class SampledCoefficients:
         if np.unique(self.rows).size != self.rows.size:
             raise ValueError("a packed coefficient depends on more than one function")
         self.basis = np.ascontiguousarray(phi_rows)
-        self.packed_basis = FieldPackedRows.of(self.basis, fields).kernel_data()
+        self.basis_by_field = FieldPackedRows.of(self.basis, fields).kernel_data()
         self.cells = CellAssembly(form, dofs, cells)
         # a packed entry that is not one dof's value as it is (a scaled or combined dof) would be misplaced:
         # the placement must give DOLFINx's own packing at a random state
@@ -381,12 +381,12 @@ class SampledCoefficients:
         """The assembled number, or the vector or matrix projected on [Phi] (cell by cell), at the reduced
         state of the functions stacked in one vector."""
         return self.cells.projected(self.offset, self.rows, self.row_function, self.row_dof, state, self.basis,
-                                    self.packed_basis)
+                                    self.basis_by_field)
 
     def assemble_rows(self, states: np.ndarray) -> np.ndarray:
         """The assembled number of a functional (an energy) at each row of ``states``, in one call."""
         return self.cells.functionals(self.offset, self.rows, self.row_function, self.row_dof, states, self.basis,
-                                      self.packed_basis)
+                                      self.basis_by_field)
 
 
 class TangentEntries:

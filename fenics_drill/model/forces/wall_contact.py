@@ -452,8 +452,9 @@ class WallContact:
         # the rows of (v, w) alone, interleaved the same way: who touches the wall is known from these
         lateral = (len(FIELDS) * np.arange(n)[:, None] + np.array([1, 2])).ravel()
         lateral_rows = self.flat[lateral] if space.sparse else np.ascontiguousarray(self.flat[lateral])
+        field_of_row = np.tile(np.arange(len(FIELDS)), n)  # the groups of the packed rows: FIELDS' order
         self.every = VertexSet(np.arange(n), lateral_rows, self.flat,
-                               None if space.sparse else FieldPackedRows.of(self.flat, np.tile(np.arange(len(FIELDS)), n)))
+                               None if space.sparse else FieldPackedRows.of(self.flat, field_of_row))
         # |P_i[:, j]|_1 of each vertex's (v, w) rows P_i: |(v, w)_i(q) - (v, w)_i(q_ref)| <= sum_j of it |dq_j|
         self._column_sizes = abs(lateral_rows[0::2]) + abs(lateral_rows[1::2])
         self.culling = culling
