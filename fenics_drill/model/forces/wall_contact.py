@@ -249,26 +249,46 @@ def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_ax
 
 
 @kernel
-def _weighted_rows(flat, active, blocks):
-    """R and A R in single precision: R, the rows of (u, v, w, theta_x) of the dense [Phi] at the vertices
-    in contact, A the blocks of :func:`_contact_blocks`; the wall's tangent is R^T (A R), one BLAS product
-    that reads R transposed in place."""
-    size = flat.shape[1]
-    rows = np.empty((4 * active.size, size), dtype=np.float32)
-    weighted = np.zeros((4 * active.size, size), dtype=np.float32)
+def _weighted_rows(packed, active, blocks):
+    """R and A R by field, in single precision, from the rows of (u, v, w, theta_x) at the vertices ``active``,
+    packed by field (:meth:`~fenics_drill.model.packed_rows.FieldPackedRows.kernel_data`, groups in the order of
+    FIELDS), and the blocks A of :func:`_contact_blocks`.  With the fields' columns concatenated (field g's at
+    ``offsets[g]``), ``rows[f]`` holds each vertex's row of field f on its own columns and ``weighted[f]`` its
+    row f of A R on all of them; the wall's tangent is the sum over f of rows[f]^T weighted[f] (block row f),
+    scattered onto the columns (:func:`_scattered_square`): a quarter of the dense product R^T (A R)."""
+    values, _, columns, counts = packed
+    offsets = np.zeros(5, dtype=np.int64)
+    for f in range(4):
+        offsets[f + 1] = offsets[f] + counts[f]
+    rows = np.zeros((4, active.size, columns.shape[1]), dtype=np.float32)
+    weighted = np.zeros((4, active.size, offsets[4]), dtype=np.float32)
     for k in range(active.size):
+        base = 4 * active[k]
         for f in range(4):
-            source = 4 * active[k] + f
-            for j in range(size):
-                rows[4 * k + f, j] = flat[source, j]
+            for c in range(counts[f]):
+                rows[f, k, c] = values[base + f, c]
         for o in range(4):
             for f in range(4):
                 a = blocks[k, o, f]
                 if a != 0.0:
-                    source = 4 * active[k] + f
-                    for j in range(size):
-                        weighted[4 * k + o, j] += a * flat[source, j]
-    return rows, weighted
+                    for c in range(counts[f]):
+                        weighted[o, k, offsets[f] + c] += a * values[base + f, c]
+    return rows, weighted, offsets
+
+
+@kernel
+def _scattered_square(matrix, columns, counts, packed):
+    """matrix[i, j] += packed[a, b] with i, j the columns of the packed rows' concatenated fields a, b."""
+    index = np.empty(packed.shape[0], dtype=np.int64)
+    at = 0
+    for f in range(counts.size):
+        for c in range(counts[f]):
+            index[at] = columns[f, c]
+            at += 1
+    for a in range(index.size):
+        for b in range(index.size):
+            matrix[index[a], index[b]] += packed[a, b]
+    return matrix
 
 
 @kernel
@@ -610,7 +630,11 @@ class WallContact:
             return self._updated_tangent(vertices, blocks)
         kept_blocks = moved_blocks
         if changed.size:
-            rows, weighted = _weighted_rows(self.flat, changed, increments)
-            matrix = matrix + (rows.T @ weighted).astype(float)
+            packed = self.every.packed
+            rows, weighted, offsets = _weighted_rows(packed.kernel_data(), changed, increments)
+            by_field = np.empty((offsets[-1], offsets[-1]), dtype=np.float32)
+            for f in range(len(FIELDS)):  # block row f: R_f^T (A R)_f, one single-precision BLAS product
+                by_field[offsets[f]:offsets[f + 1]] = rows[f, :, :packed.counts[f]].T @ weighted[f]
+            matrix = _scattered_square(matrix.copy(), packed.columns, packed.counts, by_field.astype(float))
         self._kept_tangent = (matrix, kept_blocks, updates + 1)
         return matrix
