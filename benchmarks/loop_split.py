@@ -23,7 +23,7 @@ from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.model.forces.bit_rock import BitRock
 from fenics_drill.model.forces.wall_contact import WallContact
 from fenics_drill.model.internal_force import AssembledInternalForce
-from fenics_drill.model.spaces import ModalSpace
+from fenics_drill.model.reduction.spaces import ModalSpace
 from fenics_drill.scene import load_scene
 from fenics_drill.studies.run import run_scene
 

@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 
 from fenics_drill.model.discretization import BeamDiscretization
-from fenics_drill.model.modes import solve_modes
+from fenics_drill.model.reduction.modes import solve_modes
 from fenics_drill.studies.modal_report import modal_report
 from fenics_drill.scene import load_scene
 

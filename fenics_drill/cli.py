@@ -246,7 +246,7 @@ def _user_errors() -> tuple[type, ...]:
     from fenics_drill.io.files import UnreadableFile
     from fenics_drill.io.output_directory import OutputError
     from fenics_drill.model.resources import ResourceError
-    from fenics_drill.model.spaces import BasisError
+    from fenics_drill.model.reduction.spaces import BasisError
     from fenics_drill.plots.directory import NothingToPlot
     from fenics_drill.model.rotating_modes import Divergence
     from fenics_drill.studies.campbell import CampbellError

@@ -244,21 +244,21 @@ class Modal:
 class Reduction:
     rule: str = key("auto", "'auto' (flexural modes up to 5 x the spin frequency, torsional and axial ones up to "
                     "what the time step resolves, plus the torsional modes of a stuck bit: "
-                    "fenics_drill/model/modes.py), 'paper' (Section 6.3 as printed, Table 4), 'band' (f* upper "
+                    "fenics_drill/model/reduction/modes.py), 'paper' (Section 6.3 as printed, Table 4), 'band' (f* upper "
                     "bounds per family), 'count' (number of modes per family) or 'none' (full order)",
                     choices=("auto", "paper", "band", "count", "none"))
     flexural: float = _band_or_count("flexural f* upper bound ('band') or mode count ('count')")
     torsional: float = _band_or_count("torsional f* upper bound ('band') or mode count ('count')")
     axial: float = _band_or_count("axial f* upper bound ('band') or mode count ('count')")
     enrich: bool = key(True, "add to the basis the static response of every load it misses beyond "
-                       "reduction.guard_tolerance, with its axial companion (fenics_drill/model/enrichment.py); "
+                       "reduction.guard_tolerance, with its axial companion (fenics_drill/model/reduction/enrichment.py); "
                        "false: a basis missing a load beyond the tolerance stops the command")
     axial_companions: bool = key(False, "also check and add the axial companion (static modal derivative) of "
                                  "each load's response: off by default, the static state carries the large "
                                  "deflections and the companions spoil the bit dynamics (benchmarks/"
                                  "reduced_accuracy.md)")
     hyper: bool = key(True, "evaluate the nonlinear internal forces (48)-(49) of a modal basis on a weighted sample of "
-                      "elements (ECSW, fenics_drill/model/hyper_reduction.py), trained on a short run of the "
+                      "elements (ECSW, fenics_drill/model/reduction/hyper_reduction.py), trained on a short run of the "
                       "unsampled model; false: on every element")
     hyper_tolerance: float = key(1e-4, "relative error of the sampled projected nonlinear forces on the training "
                                  "states [-]", lambda x: 0 < x < 1, "in (0, 1)")
@@ -268,7 +268,7 @@ class Reduction:
                                      "vectors combine into a light, "
                                      "stiff twist of the bit, which rang against the bit law's falling torque; "
                                      "0.1 stops it, 1 moved some efficiencies by 0.6-0.9 %: "
-                                     "fenics_drill/model/out_of_band_damping.py); 0: none [-]",
+                                     "fenics_drill/model/reduction/out_of_band_damping.py); 0: none [-]",
                                      lambda x: 0 <= x <= 10, "in [0, 10]")
     guard_tolerance: float = key(0.03, "largest admissible share of a load's static response the basis may miss "
                                  "(square root of the missed strain-energy share; 0.03 = 0.1 % of the energy); 1 "

@@ -40,14 +40,59 @@ def test_no_module_imports_from_a_higher_layer():
     upward = []
     for module, path in modules():
         own = layer(module)
-        for node in ast.walk(ast.parse(path.read_text())):
-            names = []
-            if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("fenics_drill."):
-                names = [node.module]
-            elif isinstance(node, ast.Import):
-                names = [a.name for a in node.names if a.name.startswith("fenics_drill.")]
-            upward += [f"{module} imports {name}" for name in names if layer(name) > own]
+        upward += [f"{module} imports {name}" for name in imported_modules(path) if layer(name) > own]
     assert not upward, upward
+
+
+#: Inside the model layer, the same rule between its concerns (fenics_drill/model/__init__.py).
+MODEL_PARTS = {
+    "fenics_drill.model.kernels": 0,
+    "fenics_drill.model.discretization": 1,
+    "fenics_drill.model.resources": 1,
+    "fenics_drill.model.operators": 1,
+    "fenics_drill.model.internal_force": 1,
+    "fenics_drill.model.forces": 1,
+    "fenics_drill.model.top_drive": 1,
+    "fenics_drill.model.reduction": 2,
+    "fenics_drill.model.drillstring": 3,
+    "fenics_drill.model.rotating_modes": 3,
+}
+
+
+def model_part(module: str) -> int:
+    matches = [name for name in MODEL_PARTS if module == name or module.startswith(name + ".")]
+    assert matches, f"{module} belongs to no part of MODEL_PARTS"
+    return MODEL_PARTS[max(matches, key=len)]
+
+
+def imported_modules(path: Path) -> list[str]:
+    names = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("fenics_drill."):
+            names.append(node.module)
+        elif isinstance(node, ast.Import):
+            names += [a.name for a in node.names if a.name.startswith("fenics_drill.")]
+    return names
+
+
+def test_inside_the_model_kernels_physics_and_reduction_import_only_downwards():
+    upward = []
+    for module, path in modules():
+        if not module.startswith("fenics_drill.model.") or module == "fenics_drill.model":
+            continue
+        own = model_part(module)
+        upward += [f"{module} imports {name}" for name in imported_modules(path)
+                   if name.startswith("fenics_drill.model.") and model_part(name) > own]
+    assert not upward, upward
+
+
+def test_every_package_directory_ships_in_the_wheel():
+    """pyproject.toml lists the packages explicitly (forms/ is mapped into fenics_drill.forms)."""
+    import tomllib
+
+    listed = set(tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    found = {".".join(p.parent.relative_to(PACKAGE.parent).parts) for p in PACKAGE.rglob("__init__.py")}
+    assert found | {"fenics_drill.forms"} == listed
 
 
 def test_every_force_lives_in_its_own_module_and_is_registered():

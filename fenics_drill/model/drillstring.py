@@ -26,13 +26,13 @@ import numpy as np
 
 from fenics_drill.model.discretization import THETA_X, U, V, W, BeamDiscretization
 from fenics_drill.model.forces import ForceEvaluation, build_forces
-from fenics_drill.model.hyper_reduction import RETRAIN_ABOVE, sampling_error, train_sample
+from fenics_drill.model.reduction.hyper_reduction import RETRAIN_ABOVE, sampling_error, train_sample
 from fenics_drill.model.internal_force import ElementSample, internal_force
-from fenics_drill.model.modes import band_frequency
+from fenics_drill.model.reduction.modes import band_frequency
 from fenics_drill.model.operators import LinearOperators, assemble_linear
-from fenics_drill.model.out_of_band_damping import OutOfBandDamping
-from fenics_drill.model.enrichment import augment
-from fenics_drill.model.spaces import FullSpace, ModalSpace, solution_space, stack_rows
+from fenics_drill.model.reduction.out_of_band_damping import OutOfBandDamping
+from fenics_drill.model.reduction.enrichment import augment
+from fenics_drill.model.reduction.spaces import FullSpace, ModalSpace, solution_space, stack_rows
 from fenics_drill.model.top_drive import DriveLoads, TopDrive
 
 
@@ -204,7 +204,7 @@ class DrillstringModel:
 
     def with_sample(self, sample: ElementSample, report: dict, training_states: list) -> "DrillstringModel":
         """A model whose nonlinear internal forces are evaluated on an element sample (ECSW,
-        :mod:`fenics_drill.model.hyper_reduction`); the unsampled forces stay as ``exact_internal``, the
+        :mod:`fenics_drill.model.reduction.hyper_reduction`); the unsampled forces stay as ``exact_internal``, the
         reference of the error indicator, and ``report`` says how the sample was trained on
         ``training_states``."""
         model = copy.copy(self)
@@ -279,7 +279,7 @@ class DrillstringModel:
     def evaluation_at(self, q, qd, residual, internal, external, evaluations: dict, coefficients,
                       internal_parts) -> Evaluation:
         """The :meth:`evaluate` of (q, qd) with its tangent, from a residual and force evaluations computed
-        elsewhere (:mod:`fenics_drill.model.compiled_residual`); ``internal_parts`` whole."""
+        elsewhere (:mod:`fenics_drill.solvers.compiled_residual`); ``internal_parts`` whole."""
         out = Evaluation(residual, internal, external, evaluations, self.drive.evaluate(q, qd))
         self._with_tangent(out, coefficients, internal_parts)
         return out

@@ -27,10 +27,10 @@ from dolfinx import fem
 from petsc4py import PETSc
 
 from fenics_drill.forms import energies
-from fenics_drill.model.cell_kernels import CellAssembly
+from fenics_drill.model.kernels.cell_kernels import CellAssembly
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.operators import LinearOperators
-from fenics_drill.model.packed_rows import FieldPackedRows
+from fenics_drill.model.kernels.packed_rows import FieldPackedRows
 
 
 def quadratic_forms(matrix: np.ndarray, rows: np.ndarray) -> np.ndarray:
@@ -73,7 +73,7 @@ class LinearInternalForce:
 @dataclass(frozen=True)
 class ElementSample:
     """A reduced quadrature over the elements: the cells evaluated and their weights (ECSW,
-    :mod:`fenics_drill.model.hyper_reduction`)."""
+    :mod:`fenics_drill.model.reduction.hyper_reduction`)."""
 
     cells: np.ndarray
     weights: np.ndarray
@@ -235,7 +235,7 @@ class AssembledInternalForce:
         return self._packing.element_tensors(np.concatenate((q, qd, qdd)))
 
     def kernel_data(self) -> tuple | None:
-        """What :func:`~fenics_drill.model.compiled_residual.residual_at` needs to evaluate this force as
+        """What :func:`~fenics_drill.solvers.compiled_residual.residual_at` needs to evaluate this force as
         :meth:`evaluate` does: (sampled, [K C M] or an empty matrix, the packed coefficients' placement, the
         basis rows, dense and packed by field, and the residual kernel's address, constants, coordinates, cell
         dofs and size); None in the full space."""
@@ -320,13 +320,13 @@ class SampledCoefficients:
     An evaluation forms those values, the sampled rows of [Phi] times the reduced values of each function
     (one product that reads the rows once; a map per packed entry would read each shared dof's row again
     for every cell and function), places them where DOLFINx packs them (found once), and runs the cells'
-    kernels (:class:`~fenics_drill.model.cell_kernels.CellAssembly`), without setting the functions or
+    kernels (:class:`~fenics_drill.model.kernels.cell_kernels.CellAssembly`), without setting the functions or
     DOLFINx's packing and assembly paths."""
 
     def __init__(self, form: fem.Form, functions, dofs: np.ndarray, phi_rows: np.ndarray, cells: np.ndarray,
                  fields: np.ndarray):
         """``cells``: the sample (the form is integrated over all cells: its packing is read at these);
-        ``fields``: the field of each dof (the rows are packed by it: :mod:`~fenics_drill.model.packed_rows`)."""
+        ``fields``: the field of each dof (the rows are packed by it: :mod:`~fenics_drill.model.kernels.packed_rows`)."""
         for function in functions:
             function.x.array[:] = 0.0
         (key, packed), = fem.pack_coefficients(form).items()

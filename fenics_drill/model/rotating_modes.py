@@ -17,7 +17,7 @@ one linearisation serves a whole sweep.
 Each speed is one quadratic eigenproblem (lambda^2 M + lambda (C + Omega G) + K) x = 0, solved by SLEPc's
 PEP (TOAR, shift-and-invert about 0, so the lowest |lambda| come first).  Each mode is classified by the
 orbit of (v, w) at the vertices (forward or backward whirl) and by its kinetic energy per field
-(flexural, torsional, axial, as :func:`fenics_drill.model.modes.classify`).
+(flexural, torsional, axial, as :func:`fenics_drill.model.reduction.modes.classify`).
 """
 
 from __future__ import annotations
@@ -30,12 +30,12 @@ import scipy.sparse as sp
 from petsc4py import PETSc
 from slepc4py import SLEPc
 
-from fenics_drill.model.compiled import interrupt_in
+from fenics_drill.model.kernels.compiled import interrupt_in
 from fenics_drill.model.discretization import DRIVE, THETA_X, THETA_Y, THETA_Z, V, W, BeamDiscretization
 from fenics_drill.model.internal_force import internal_force
-from fenics_drill.model.modes import classify, shift_and_invert
+from fenics_drill.model.reduction.modes import classify, shift_and_invert
 from fenics_drill.model.operators import LinearOperators
-from fenics_drill.model.spaces import FullSpace
+from fenics_drill.model.reduction.spaces import FullSpace
 
 #: Below this amplitude-weighted |orbit ratio| a lateral mode whirls along a line, not round (a
 #: degenerate pair at Omega = 0, or a string on the wall that moves sideways only).

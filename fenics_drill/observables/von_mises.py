@@ -42,8 +42,8 @@ import ufl
 from dolfinx import fem
 from numba import njit
 
-from fenics_drill.model.cell_kernels import CellExpression, tabulate_at_cells
-from fenics_drill.model.compiled import kernel
+from fenics_drill.model.kernels.cell_kernels import CellExpression, tabulate_at_cells
+from fenics_drill.model.kernels.compiled import kernel
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.forms.energies import green_lagrange_strains, linear_strains, strain_slots
 
@@ -164,7 +164,7 @@ def _at_ends(c, ends):
 def _batch_maxima(sampled, end_cells, dofs_rows, monomials, monomial_bounds, radius, young_modulus,
                   shear_modulus, ends):
     """:func:`_largest` of each state (a row of ``dofs_rows``) over the strains' coefficients of the expression
-    ``sampled`` (address, cell dofs, constants, coordinates, size: :func:`~fenics_drill.model.cell_kernels.
+    ``sampled`` (address, cell dofs, constants, coordinates, size: :func:`~fenics_drill.model.kernels.cell_kernels.
     tabulate_at_cells`), or the stress recovered at an end (:func:`_at_ends` of the coefficients that the
     expression ``end_cells`` gives; index points + e of end e) where that is larger: one call for many steps."""
     address, cell_dofs, constants, coordinates, size = sampled

@@ -5,7 +5,7 @@ step before them ended with and converge in two evaluations (solvers/newmark.py,
 others form one at their predictor and keep it.  In Python their evaluations, tests and updates cost about as
 much as their kernels (benchmarks/RESULTS.md, item 77).  :func:`kept_tangent_step` takes such a step as
 :meth:`NewmarkNewton.step` does, with its tangent's LU kept: the predictor, the residual
-(:func:`~fenics_drill.model.compiled_residual.residual_at`), the convergence test, the settle test, the full update
+(:func:`~fenics_drill.solvers.compiled_residual.residual_at`), the convergence test, the settle test, the full update
 and its sufficient decrease, and the contraction test that keeps the tangent.  Where that Newton would do
 anything else (a fresh tangent, a fresh stiffness, a halved or kinked update, a vertex the wall's culled set may
 miss, no convergence) it returns without a result, and the step is taken in Python from its start: every step is
@@ -19,15 +19,15 @@ import math
 import numpy as np
 from numba import njit
 
-from fenics_drill.model.compiled import kernel
-from fenics_drill.model.compiled_residual import NO_BIT as _NO_BIT
-from fenics_drill.model.compiled_residual import NO_WALL as _NO_WALL
-from fenics_drill.model.compiled_residual import residual_at
+from fenics_drill.model.kernels.compiled import kernel
+from fenics_drill.solvers.compiled_residual import NO_BIT as _NO_BIT
+from fenics_drill.solvers.compiled_residual import NO_WALL as _NO_WALL
+from fenics_drill.solvers.compiled_residual import residual_at
 
 
 @njit(cache=True)
 def _saddle_solve(factors, pivots, scale, rhs_q, rhs_c):
-    """getrs of :class:`~fenics_drill.model.spaces.SaddleLU`: (dq, mu) of [[J, k B^T], [k B, 0]] from its LU
+    """getrs of :class:`~fenics_drill.model.reduction.spaces.SaddleLU`: (dq, mu) of [[J, k B^T], [k B, 0]] from its LU
     (row interchanges ``pivots``, 0-based), the constraint rows scaled by k = ``scale``."""
     n, size = rhs_q.size, factors.shape[0]
     x = np.empty(size)

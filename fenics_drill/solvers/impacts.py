@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fenics_drill.model.compiled import kernel
+from fenics_drill.model.kernels.compiled import kernel
 
 #: The share of the gap a vertex must have moved away from the wall, since its last contact, for its next
 #: contact to count as an impact: 15 um on the paper's string, 1.5 times the step control's displacement

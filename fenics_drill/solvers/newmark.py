@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fenics_drill.model.compiled_residual import CompiledResidual
+from fenics_drill.solvers.compiled_residual import CompiledResidual
 from fenics_drill.model.drillstring import DrillstringModel, Evaluation
-from fenics_drill.model.spaces import column_bound
+from fenics_drill.model.reduction.spaces import column_bound
 from fenics_drill.solvers.compiled_step import kept_tangent_step
 from fenics_drill.solvers.newton import ARMIJO, KeptTangent, saddle_newton
 

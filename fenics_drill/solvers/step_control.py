@@ -27,8 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from fenics_drill.model.modes import band_frequency
-from fenics_drill.model.spaces import column_bound, stack_rows
+from fenics_drill.model.reduction.modes import band_frequency
+from fenics_drill.model.reduction.spaces import column_bound, stack_rows
 
 
 class StepTooSmall(RuntimeError):

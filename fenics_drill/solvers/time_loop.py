@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fenics_drill.model.drillstring import DrillstringModel, Evaluation
-from fenics_drill.model.hyper_reduction import CHECK_INTERVAL
+from fenics_drill.model.reduction.hyper_reduction import CHECK_INTERVAL
 from fenics_drill.solvers.energy_budget import EnergyBudget, PowerTerms
 from fenics_drill.solvers.impacts import ImpactCounter
 from fenics_drill.solvers.newmark import NewmarkNewton, NewtonFailure, State

@@ -25,7 +25,7 @@ from fenics_drill.model.forces.bit_rock import bit_rock_force
 from fenics_drill.model.forces.wall_contact import WallContact
 from fenics_drill.model.operators import assemble_linear
 from fenics_drill.model.rotating_modes import held_space, linearise_about_spin, solve_whirl_modes
-from fenics_drill.model.spaces import FullSpace
+from fenics_drill.model.reduction.spaces import FullSpace
 from fenics_drill.solvers.static import solve_static
 from fenics_drill.studies.lifecycle import command_output
 

@@ -8,9 +8,9 @@ from pathlib import Path
 from fenics_drill.forms import FIELD_NAMES
 from fenics_drill.io.files import write_json
 from fenics_drill.model.discretization import BeamDiscretization
-from fenics_drill.model.modes import family_counts, select_modes
+from fenics_drill.model.reduction.modes import family_counts, select_modes
 from fenics_drill.model.operators import assemble_linear
-from fenics_drill.model.spaces import solution_space
+from fenics_drill.model.reduction.spaces import solution_space
 from fenics_drill.studies.lifecycle import command_output
 
 

@@ -17,11 +17,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from fenics_drill.model.drillstring import DrillstringModel, build_model
-from fenics_drill.model.enrichment import (basis_error, bit_loads, missed_share, tangent_responses,
+from fenics_drill.model.reduction.enrichment import (basis_error, bit_loads, missed_share, tangent_responses,
                                              wall_friction_loads)
-from fenics_drill.model.hyper_reduction import train_sample
+from fenics_drill.model.reduction.hyper_reduction import train_sample
 from fenics_drill.model.internal_force import AssembledInternalForce
-from fenics_drill.model.spaces import ModalSpace
+from fenics_drill.model.reduction.spaces import ModalSpace
 from fenics_drill.observables.drilling_quantities import bit_bounce, drilling_quantities, stick_slip
 from fenics_drill.observables.step_rows import StepRows
 from fenics_drill.solvers.static import StaticEquilibrium, StaticFailure, solve_static, static_report

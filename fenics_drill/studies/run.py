@@ -21,7 +21,7 @@ from fenics_drill.io.files import write_json
 from fenics_drill.io.output_directory import claim_output
 from fenics_drill.io.timeseries import TimeSeriesWriter, read_series
 from fenics_drill.model.drillstring import DrillstringModel
-from fenics_drill.model.modes import drive_held_modes
+from fenics_drill.model.reduction.modes import drive_held_modes
 from fenics_drill.model.resources import check_memory
 from fenics_drill.observables.drilling_quantities import drilling_quantities, spin_variation_ratio
 from fenics_drill.observables.step_rows import StepRows

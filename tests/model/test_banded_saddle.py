@@ -1,4 +1,4 @@
-"""The banded saddle solve of the full order (fenics_drill/model/banded_saddle.py) against a dense solve
+"""The banded saddle solve of the full order (fenics_drill/model/kernels/banded_saddle.py) against a dense solve
 of the bordered system (76), and on a full-order string against SciPy's sparse LU."""
 
 import numpy as np
@@ -6,7 +6,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from fenics_drill.model.banded_saddle import BandedSaddle
+from fenics_drill.model.kernels.banded_saddle import BandedSaddle
 from fenics_drill.model.drillstring import build_model
 from conftest import scene_with
 

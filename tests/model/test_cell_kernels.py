@@ -1,4 +1,4 @@
-"""FFCx's element kernels called from Numba on an element sample (fenics_drill/model/cell_kernels.py), and
+"""FFCx's element kernels called from Numba on an element sample (fenics_drill/model/kernels/cell_kernels.py), and
 the wall law in one pass over a modal space's rows (fenics_drill/model/forces/wall_contact.py)."""
 
 import numpy as np
@@ -7,7 +7,7 @@ import ufl
 from conftest import scene_with
 from dolfinx import fem
 
-from fenics_drill.model.cell_kernels import CellAssembly
+from fenics_drill.model.kernels.cell_kernels import CellAssembly
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.forces.wall_contact import _contact_blocks, _modal_pass, _projected_laws, _vertex_loads
 from fenics_drill.model.internal_force import ElementSample, InternalForms, SampledCoefficients

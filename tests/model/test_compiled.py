@@ -1,4 +1,4 @@
-"""Compiled kernels stop like the rest of the code when a run is interrupted (fenics_drill/model/compiled.py)."""
+"""Compiled kernels stop like the rest of the code when a run is interrupted (fenics_drill/model/kernels/compiled.py)."""
 
 import os
 import signal

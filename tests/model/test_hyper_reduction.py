@@ -1,10 +1,10 @@
-"""ECSW hyper-reduction of the nonlinear internal forces (fenics_drill/model/hyper_reduction.py)."""
+"""ECSW hyper-reduction of the nonlinear internal forces (fenics_drill/model/reduction/hyper_reduction.py)."""
 
 import numpy as np
 import pytest
 from conftest import scene_with
 
-from fenics_drill.model.hyper_reduction import (ElementSample, element_forces, sampling_error, sparse_nnls, spin_shift,
+from fenics_drill.model.reduction.hyper_reduction import (ElementSample, element_forces, sampling_error, sparse_nnls, spin_shift,
                                                  train_sample)
 from fenics_drill.model.internal_force import AssembledInternalForce
 from fenics_drill.solvers.time_loop import Simulation

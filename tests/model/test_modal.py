@@ -7,8 +7,8 @@ import pytest
 from conftest import scene_with
 
 from fenics_drill.model.discretization import DRIVE, BeamDiscretization
-from fenics_drill.model import modes
-from fenics_drill.model.modes import auto_bands, drive_held_modes, paper_bands, solve_modes, stuck_bit_modes
+from fenics_drill.model.reduction import modes
+from fenics_drill.model.reduction.modes import auto_bands, drive_held_modes, paper_bands, solve_modes, stuck_bit_modes
 from fenics_drill.model.operators import assemble_linear
 from fenics_drill.studies.modal_report import modal_report
 
@@ -332,7 +332,7 @@ def test_the_guard_measures_what_a_basis_misses_without_a_round_off_floor():
     stiffness it is the closed form sqrt(sum_out k v^2 / sum k v^2)."""
     import scipy.sparse as sp
 
-    from fenics_drill.model.enrichment import basis_error
+    from fenics_drill.model.reduction.enrichment import basis_error
 
     rng = np.random.default_rng(0)
     k = rng.uniform(1.0, 1e6, size=40)

@@ -1,9 +1,9 @@
-"""Rows of [Phi] packed by field (model/packed_rows.py) against the dense products they replace."""
+"""Rows of [Phi] packed by field (model/kernels/packed_rows.py) against the dense products they replace."""
 
 import numpy as np
 from numba import njit
 
-from fenics_drill.model.packed_rows import FieldPackedRows, add_row, dot_row, dot_row_twice, gathered, scatter
+from fenics_drill.model.kernels.packed_rows import FieldPackedRows, add_row, dot_row, dot_row_twice, gathered, scatter
 
 
 @njit

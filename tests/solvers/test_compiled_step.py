@@ -1,13 +1,13 @@
-"""The compiled Newmark step (solvers/compiled_step.py) and its residual (model/compiled_residual.py) against the
+"""The compiled Newmark step (solvers/compiled_step.py) and its residual (solvers/compiled_residual.py) against the
 Python step and the model's own evaluation."""
 
 import numpy as np
 import pytest
 
 from conftest import scene_with
-from fenics_drill.model.compiled_residual import CompiledResidual, residual_at
+from fenics_drill.solvers.compiled_residual import CompiledResidual, residual_at
 from fenics_drill.model.drillstring import build_model
-from fenics_drill.model.spaces import SaddleLU
+from fenics_drill.model.reduction.spaces import SaddleLU
 from fenics_drill.solvers.compiled_step import _saddle_solve
 from fenics_drill.solvers.time_loop import Simulation
 from fenics_drill.studies.prepare import prepare

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from fenics_drill.model.forces.bit_rock import KINK_PAST, step_past_kink
-from fenics_drill.model.spaces import ModalSpace
+from fenics_drill.model.reduction.spaces import ModalSpace
 from fenics_drill.solvers.newton import saddle_newton
 
 #: r(y) = y + K max(y, 0) - b: a unit spring, and a stiff one that acts only for y > 0 (as F_BR acts only

@@ -18,7 +18,7 @@ import pytest
 from conftest import PAPER
 
 from fenics_drill.model.discretization import DRIVE, BeamDiscretization
-from fenics_drill.model.modes import solve_modes
+from fenics_drill.model.reduction.modes import solve_modes
 from fenics_drill.model.operators import assemble_linear
 from fenics_drill.model.rotating_modes import Divergence, held_space, linearise_about_spin, solve_whirl_modes
 from fenics_drill.scene import load_scene

@@ -12,7 +12,7 @@ import pytest
 from conftest import PAPER
 
 from fenics_drill.model.discretization import THETA_X, U, W
-from fenics_drill.model.spaces import BasisError
+from fenics_drill.model.reduction.spaces import BasisError
 from fenics_drill.observables.von_mises import VonMisesProbe
 from fenics_drill.scene import load_scene
 from fenics_drill.studies.prepare import prepare
@@ -157,10 +157,10 @@ def test_the_held_top_carries_the_whole_wall_friction_of_a_resting_string_with_t
     adds up in the string's axial force, which the held top carries: E A u'(0) = sum of the friction loads (a
     bar held at x = 0, free at the bit, nodal loads: the FE strain of the first element is exact).  The band's
     axial modes miss 28 % of that static response and half of the strain at the top, where the peak stress
-    sits; the guard finds it and the enrichment adds it (fenics_drill/model/enrichment.py)."""
+    sits; the guard finds it and the enrichment adds it (fenics_drill/model/reduction/enrichment.py)."""
     scene = load_scene(PAPER, ["model.geometric_nonlinearity=false", "model.inertial_nonlinearity=false"])
     from fenics_drill.model.drillstring import build_model
-    from fenics_drill.model.enrichment import StaticSolver, wall_friction_loads, wall_rest_load
+    from fenics_drill.model.reduction.enrichment import StaticSolver, wall_friction_loads, wall_rest_load
     from fenics_drill.model.operators import assemble_linear
 
     model = build_model(scene)
@@ -242,15 +242,15 @@ STICKING = ["beam.length=101.068", "beam.elements=253", "beam.outer_radius=0.056
 
 
 def test_the_basis_damps_its_directions_above_the_band_and_nothing_else():
-    """fenics_drill/model/out_of_band_damping.py: every Ritz direction of the basis resting on the wall (its stiffness
+    """fenics_drill/model/reduction/out_of_band_damping.py: every Ritz direction of the basis resting on the wall (its stiffness
     with the wall's springs, DrillstringModel.resting_at) above 2 f_max gets the modal
     damping 2 zeta omega (zeta = reduction.out_of_band_damping), those below and the rigid spin and feed none (to
     round-off of the largest damping), and the bit-local twist, the direction that moves the bit's rotation most
     per unit of kinetic energy (on this string 1555 Hz where f_max = 201 Hz), is among the damped."""
     import scipy.linalg as sl
 
-    from fenics_drill.model.modes import band_frequency
-    from fenics_drill.model.out_of_band_damping import OUT_OF_BAND_FACTOR
+    from fenics_drill.model.reduction.modes import band_frequency
+    from fenics_drill.model.reduction.out_of_band_damping import OUT_OF_BAND_FACTOR
 
     scene = load_scene(PAPER, [*STICKING, "reduction.out_of_band_damping=0.7"])
     prepared = prepare(scene, dynamics=False)

@@ -15,7 +15,7 @@ from typing import ClassVar
 import numpy as np
 from numba import njit
 
-from fenics_drill.model.compiled import kernel
+from fenics_drill.model.kernels.compiled import kernel
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
 from fenics_drill.scene import LAW_SIGN
@@ -58,7 +58,7 @@ def _law(bit_velocity, bit_spin_rate, limit_force, rate, friction, borehole_radi
             friction * force * borehole_radius * _regularisation_slope(bit_spin_rate))
 
 
-#: :func:`_law` itself, for compiled code that evaluates the bit (model/compiled_residual.py).
+#: :func:`_law` itself, for compiled code that evaluates the bit (solvers/compiled_residual.py).
 LAW = _law.compiled
 
 
@@ -155,7 +155,7 @@ class BitRock:
 
     def kernel_data(self) -> tuple:
         """(the rows of u(L), theta_x(L), their unit loads, the law's constants) for
-        :func:`~fenics_drill.model.compiled_residual.residual_at` (a modal space)."""
+        :func:`~fenics_drill.solvers.compiled_residual.residual_at` (a modal space)."""
         return (self.rows.dense(), np.array(self._unit_loads),
                 (self.limit_force, self.rate, self.friction, self.borehole_radius))
 

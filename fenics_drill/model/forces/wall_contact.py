@@ -20,14 +20,14 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from fenics_drill.model.compiled import REASSOCIATE, kernel
+from fenics_drill.model.kernels.compiled import REASSOCIATE, kernel
 from fenics_drill.model.discretization import THETA_X as TX_FIELD
 from fenics_drill.model.discretization import U as U_FIELD
 from fenics_drill.model.discretization import V as V_FIELD
 from fenics_drill.model.discretization import W as W_FIELD
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
-from fenics_drill.model.packed_rows import FieldPackedRows, add_row, dot_row, dot_row_twice, gathered, scatter
+from fenics_drill.model.kernels.packed_rows import FieldPackedRows, add_row, dot_row, dot_row_twice, gathered, scatter
 from fenics_drill.scene import LAW_SIGN
 
 FIELDS = (U_FIELD, V_FIELD, W_FIELD, TX_FIELD)  # the fields the wall acts on: F_a, F_v, F_w, T_FS
@@ -186,7 +186,7 @@ def _modal_pass(packed, size, q, qd, gap, k1, k2, damping, printed, mu_axial, mu
     return delta, nodal, laws, potential, generalised, lateral, rates
 
 
-#: :func:`_modal_pass` itself, for compiled code that evaluates the wall (model/compiled_residual.py).
+#: :func:`_modal_pass` itself, for compiled code that evaluates the wall (solvers/compiled_residual.py).
 MODAL_PASS = _modal_pass.compiled
 
 
@@ -251,7 +251,7 @@ def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_ax
 @kernel
 def _weighted_rows(packed, active, blocks):
     """R and A R by field, in single precision, from the rows of (u, v, w, theta_x) at the vertices ``active``,
-    packed by field (:meth:`~fenics_drill.model.packed_rows.FieldPackedRows.kernel_data`, groups in the order of
+    packed by field (:meth:`~fenics_drill.model.kernels.packed_rows.FieldPackedRows.kernel_data`, groups in the order of
     FIELDS), and the blocks A of :func:`_contact_blocks`.  With the fields' columns concatenated (field g's at
     ``offsets[g]``), ``rows[f]`` holds each vertex's row of field f on its own columns and ``weighted[f]`` its
     row f of A R on all of them; the wall's tangent is the sum over f of rows[f]^T weighted[f] (block row f),
@@ -569,7 +569,7 @@ class WallContact:
     def kernel_data(self, vertex_set: VertexSet) -> tuple:
         """(the packed rows of ``vertex_set``, the law's constants, and the bound that keeps it: its columns'
         sizes, reference q and reach; none for every vertex) for
-        :func:`~fenics_drill.model.compiled_residual.residual_at`."""
+        :func:`~fenics_drill.solvers.compiled_residual.residual_at`."""
         size = vertex_set.flat.shape[1]
         law = tuple(value if isinstance(value, bool) else float(value) for value in self._law())
         rows = vertex_set.packed.kernel_data()

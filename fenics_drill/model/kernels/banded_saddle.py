@@ -18,7 +18,7 @@ import numpy as np
 import scipy.linalg.lapack as lapack
 import scipy.sparse as sp
 
-from fenics_drill.model.compiled import kernel
+from fenics_drill.model.kernels.compiled import kernel
 
 
 def held_dofs(constraints) -> tuple[np.ndarray, np.ndarray]:

@@ -21,10 +21,10 @@ import scipy.sparse.linalg as spla
 from scipy.linalg.lapack import dgetrf as getrf
 from scipy.linalg.lapack import dgetrs as getrs
 
-from fenics_drill.model.banded_saddle import BandedSaddle
+from fenics_drill.model.kernels.banded_saddle import BandedSaddle
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
-from fenics_drill.model.enrichment import MODE_SPAN_TOLERANCE, augment, enrich
-from fenics_drill.model.modes import reduction_bands, select_modes, solve_modes, stuck_bit_modes
+from fenics_drill.model.reduction.enrichment import MODE_SPAN_TOLERANCE, augment, enrich
+from fenics_drill.model.reduction.modes import reduction_bands, select_modes, solve_modes, stuck_bit_modes
 from fenics_drill.model.operators import LinearOperators
 
 
@@ -303,7 +303,7 @@ class FullSpace:
 
     def saddle_solve(self, tangent, constraints, rhs_q: np.ndarray, rhs_c: np.ndarray):
         """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76), with a banded LU and the held dofs
-        eliminated (:mod:`fenics_drill.model.banded_saddle`; kept for the same J and B)."""
+        eliminated (:mod:`fenics_drill.model.kernels.banded_saddle`; kept for the same J and B)."""
         return self._saddle(tangent, constraints)(rhs_q, rhs_c)
 
 
@@ -314,7 +314,7 @@ class BasisError(ValueError):
 def solution_space(scene, disc: BeamDiscretization, operators: LinearOperators):
     """(space, kept modes, all modes, guard report, stuck-bit modes): the modal basis of the scene's
     reduction rule (Section 6.3), with the 'auto' rule's torsional modes of a stuck bit (None otherwise),
-    checked and enriched by the guard (:mod:`fenics_drill.model.enrichment`), or the full space for
+    checked and enriched by the guard (:mod:`fenics_drill.model.reduction.enrichment`), or the full space for
     'none'; all modes of the band B (for spectra) either way."""
     modes = solve_modes(disc, scene.modal.f_star_max, operators.mass)
     if scene.reduction.rule == "none":

@@ -1,8 +1,8 @@
 """Rows of a modal basis [Phi] packed on the columns of each row's field.
 
-The modes of the straight string move one group of coupled fields each (model/modes.py): u, theta_x,
+The modes of the straight string move one group of coupled fields each (model/reduction/modes.py): u, theta_x,
 (v, theta_z), (w, theta_y).  A row of [Phi] at a dof of one field is therefore zero outside the columns of
-the modes that move that field, and of the basis vectors added to them (model/enrichment.py): on the paper
+the modes that move that field, and of the basis vectors added to them (model/reduction/enrichment.py): on the paper
 scene's 62 columns u, v, w, theta_x, theta_y and theta_z have 13, 11, 14, 27, 14 and 11.  Products with
 the rows (positions of a state at the dofs, loads projected back) need only those columns.
 

@@ -10,7 +10,7 @@ wrapper that raises the interrupt as what it is.  Kernels called only from other
 
 Numba keeps a kernel's compiled code on disk (``__pycache__``) until its own file changes, not when a kernel it
 calls from another file does: after editing a kernel that kernels of other files call (the laws and passes that
-``model/compiled_residual.py`` and ``solvers/compiled_step.py`` call, ``cell_kernels.tabulate_at_cells``), touch
+``solvers/compiled_residual.py`` and ``solvers/compiled_step.py`` call, ``cell_kernels.tabulate_at_cells``), touch
 those files or delete their ``__pycache__`` directories, or they run the old code.
 """
 

@@ -1,7 +1,7 @@
 """FFCx's element kernels called from Numba: a form assembled on an element sample without DOLFINx's
 assembler, and an expression at every cell without DOLFINx's coefficient packing.
 
-A sampled internal force (:mod:`fenics_drill.model.hyper_reduction`) lives on a handful of elements, and
+A sampled internal force (:mod:`fenics_drill.model.reduction.hyper_reduction`) lives on a handful of elements, and
 at every Newton iterate DOLFINx's ``assemble_vector`` spent about ten times longer in its set-up than in
 the kernels of those cells (benchmarks/RESULTS.md, issue 17).  :class:`CellAssembly` calls the form's
 generated ``tabulate_tensor`` directly, cell after cell, and adds each element tensor at its dofs: the
@@ -19,8 +19,8 @@ from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
 
-from fenics_drill.model.compiled import REASSOCIATE, kernel
-from fenics_drill.model.packed_rows import NO_ROWS, add_row, gathered, scatter
+from fenics_drill.model.kernels.compiled import REASSOCIATE, kernel
+from fenics_drill.model.kernels.packed_rows import NO_ROWS, add_row, gathered, scatter
 
 _FFI = cffi.FFI()
 
@@ -43,7 +43,7 @@ def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, s
     """Add every cell's element tensor to ``out``: at the positions ``cell_dofs`` (a vector of ``size``, or
     with ``square`` a (size x size) matrix, row-major: the element matrix's rows are its test functions);
     or, with a ``basis`` of N > 0 columns (the rows of [Phi] at the dofs), projected on it: P_c^T f_c (from
-    the same rows packed by field, ``basis_by_field``: :mod:`~fenics_drill.model.packed_rows`), or
+    the same rows packed by field, ``basis_by_field``: :mod:`~fenics_drill.model.kernels.packed_rows`), or
     P_c^T K_c P_c (N x N) with P_c the basis rows of cell c's dofs, summed over the cells as one product of
     the stacked P_c and K_c P_c (BLAS: three quarters of the work, 52 cells of the printed kinematics)."""
     n, modes = cell_dofs.shape[1], basis.shape[1]
@@ -102,7 +102,7 @@ def _packed_at(offset, rows, row_function, row_dof, state, basis_by_field, modes
     """The packed coefficients ``offset`` plus the functions' values at the dofs: entry ``rows[i]`` is the value
     of function ``row_function[i]`` (its reduced values are that slice of ``state``) at dof ``row_dof[i]``, row
     ``row_dof[i]`` of the basis (``modes`` columns) times them; the rows packed by field, ``basis_by_field``
-    (:meth:`~fenics_drill.model.packed_rows.FieldPackedRows.kernel_data`), take a quarter of the dense rows'
+    (:meth:`~fenics_drill.model.kernels.packed_rows.FieldPackedRows.kernel_data`), take a quarter of the dense rows'
     products."""
     values, field, columns, counts = basis_by_field
     functions = state.size // modes  # one to three (U; U, V; U, V, A)
@@ -148,7 +148,7 @@ def _assemble_cells_at(address, offset, rows, row_function, row_dof, state, cons
     return out
 
 
-#: :func:`_assemble_cells_at` itself, for compiled code that assembles a force (model/compiled_residual.py).
+#: :func:`_assemble_cells_at` itself, for compiled code that assembles a force (solvers/compiled_residual.py).
 ASSEMBLE_CELLS_AT = _assemble_cells_at.compiled
 
 
@@ -294,7 +294,7 @@ class CellAssembly:
         P^T f, P^T K P), from the packed coefficients ``offset`` plus, at ``rows``, the values at the dofs
         ``row_dof`` of the functions ``row_function`` whose reduced values ``state`` stacks (the placement
         of :class:`~fenics_drill.model.internal_force.SampledCoefficients`); ``basis_by_field``: the basis packed
-        by field (:meth:`~fenics_drill.model.packed_rows.FieldPackedRows.kernel_data`)."""
+        by field (:meth:`~fenics_drill.model.kernels.packed_rows.FieldPackedRows.kernel_data`)."""
         return self._shaped(_assemble_cells_at(self.address, offset, rows, row_function, row_dof, state,
                                                self.constants, self.coordinates, self.cell_dofs, self.size,
                                                self.rank == 2, basis, basis_by_field, self.rank > 0))

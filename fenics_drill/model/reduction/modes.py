@@ -9,7 +9,7 @@ string).  Every mode is classified from its kinetic-energy fractions per field.
 Select: the modes a scene's ``reduction.rule`` keeps (the paper's Section 6.3 bands,
 Table 4; the 'auto' bands of what the scene excites and its step resolves, with the
 torsional modes of a stuck bit; bands or counts per family; or all).  Enrichment of the kept modes lives in
-:mod:`fenics_drill.model.enrichment`, the space built on them in :mod:`fenics_drill.model.spaces`.
+:mod:`fenics_drill.model.reduction.enrichment`, the space built on them in :mod:`fenics_drill.model.reduction.spaces`.
 """
 
 from __future__ import annotations

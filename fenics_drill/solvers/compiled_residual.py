@@ -3,7 +3,7 @@
 :meth:`DrillstringModel.evaluate` runs each force's kernel from Python and sums their loads there; at the
 paper scene's two evaluations per step that glue costs about as much as the kernels (benchmarks/RESULTS.md,
 items 76-77).  :func:`residual_at` runs the same kernels (the sampled internal force of
-:mod:`~fenics_drill.model.cell_kernels`, the wall's :func:`~fenics_drill.model.forces.wall_contact._modal_pass`,
+:mod:`~fenics_drill.model.kernels.cell_kernels`, the wall's :func:`~fenics_drill.model.forces.wall_contact._modal_pass`,
 the bit law (20)-(22)) and the same sums, in the same order, for the compiled Newton step of
 :mod:`fenics_drill.solvers.compiled_step`.
 
@@ -17,15 +17,15 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from fenics_drill.model.cell_kernels import ASSEMBLE_CELLS_AT
+from fenics_drill.model.kernels.cell_kernels import ASSEMBLE_CELLS_AT
 from fenics_drill.model.forces.bit_rock import LAW as BIT_LAW
 from fenics_drill.model.forces.bit_rock import BitRock
 from fenics_drill.model.forces.gravity import Gravity
 from fenics_drill.model.forces.wall_contact import MODAL_PASS as WALL_PASS
 from fenics_drill.model.forces.wall_contact import WallContact
 from fenics_drill.model.internal_force import AssembledInternalForce
-from fenics_drill.model.out_of_band_damping import OutOfBandDamping
-from fenics_drill.model.packed_rows import NO_ROWS
+from fenics_drill.model.reduction.out_of_band_damping import OutOfBandDamping
+from fenics_drill.model.kernels.packed_rows import NO_ROWS
 
 #: The kinds of point force :func:`residual_at` sums, in the order of the model's list.
 GRAVITY, WALL, BIT_ROCK, DAMPING = 0, 1, 2, 3
