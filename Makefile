@@ -2,7 +2,7 @@
 PY := .venv/bin/python
 OUT ?= out
 
-.PHONY: setup demo demo-printed demo-as-printed reproduction test bench bench-ross campbell mc optimize stick-slip clean
+.PHONY: setup docs demo demo-printed demo-as-printed reproduction test bench bench-ross campbell mc optimize stick-slip clean
 
 setup:
 	@bash scripts/bootstrap.sh
@@ -36,21 +36,26 @@ demo-as-printed: setup
 reproduction: setup
 	$(PY) benchmarks/reproduction.py --ranks $(RANKS)
 
-## The test suite (a few minutes on 2 cores).
+## The test suite (about 8 minutes on 2 cores).
 test: setup
 	$(PY) -m pytest -q tests
 
-## Speed before and after issue 17 (benchmarks/speed.md, 5 min in the eleventh sitting), the reduced models against the
-## full order (benchmarks/reduced_accuracy.md, issue 14), then the older studies.
+## The manual into docs/_build/html: warnings (a broken internal link, a bad reference) are errors, and the
+## gallery's scripts run (about 2 minutes).
+docs: setup
+	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
+
+## Speed against an older revision (benchmarks/results/speed.md, about 5 min), the cost of each part of an evaluation,
+## the reduced models against the full order (benchmarks/results/reduced_accuracy.md), then the fidelity studies
+## (benchmarks/README.md lists every script).
 bench: setup
 	$(PY) benchmarks/speed_table.py --before 50d35ac
 	$(PY) benchmarks/evaluation_costs.py
 	$(PY) benchmarks/reduced_accuracy.py --t-end 2 --runs $(OUT)/accuracy
 	$(PY) benchmarks/modal_timing.py
-	$(PY) benchmarks/dynamics_convergence.py
 	$(PY) benchmarks/tradeoff.py demos/scenes/paper.toml --t-end 0.5
 
-## Campbell diagram against ROSS (benchmarks/campbell_ross.md).  ROSS lives in its own .venv-ross: its
+## Campbell diagram against ROSS (benchmarks/results/campbell_ross.md).  ROSS lives in its own .venv-ross: its
 ## dependencies (CoolProp, pyarrow, ...) are not the project's, and once installed beside DOLFINx they broke
 ## h5py's import here (measured: "ValueError: Not a datatype").
 bench-ross: setup
@@ -58,7 +63,7 @@ bench-ross: setup
 		&& .venv-ross/bin/pip install -q ross-rotordynamics==3.1.0)
 	$(PY) benchmarks/campbell_ross.py --ross-python .venv-ross/bin/python --elements 200 --rounds 2
 
-## Critical speeds of the paper's string on the wall, without and with the weight on bit (docs/campbell.md).
+## Critical speeds of the paper's string on the wall, without and with the weight on bit (docs/guide/campbell.md).
 campbell: setup
 	$(PY) -m fenics_drill.cli campbell demos/scenes/campbell_paper.toml --overwrite --out $(OUT)/campbell
 	$(PY) -m fenics_drill.cli campbell demos/scenes/campbell_paper.toml --set campbell.weight_on_bit=true \
@@ -82,7 +87,7 @@ optimize: setup
 	$(PY) -m fenics_drill.cli plot $(OUT)/window-robust
 
 ## Stick-slip maps of the paper's string with the cutting law, stiff drive and soft-torque top drive
-## (docs/drilling_control.md), and the linear stability of steady drilling.
+## (docs/guide/drilling_control.md), and the linear stability of steady drilling.
 stick-slip: setup
 	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/stick_slip_map.toml --out $(OUT)/stick-slip-stiff --resume
 	$(PY) -m fenics_drill.cli plot $(OUT)/stick-slip-stiff
@@ -92,4 +97,4 @@ stick-slip: setup
 	$(PY) benchmarks/stick_slip_stability.py
 
 clean:
-	rm -rf $(OUT) .pytest_cache
+	rm -rf $(OUT) .pytest_cache docs/_build docs/gallery docs/reference/api.md docs/reference/scene_keys.md

@@ -8,7 +8,7 @@ v = w = 0, rotations free; ROSS with translational bearings of 1e15 N/m), with t
 (Cowper's for a hollow circle, which ROSS uses; fenics-drill takes it as ``beam.shear_factor``),
 over the same speeds.  Each round runs the whole process of each code - interpreter, imports, model,
 sweep - as a subprocess, the two alternating, so the machine's state is shared.  Writes
-benchmarks/campbell_ross.md.
+benchmarks/results/campbell_ross.md.
 """
 
 from __future__ import annotations
@@ -136,7 +136,7 @@ def main() -> None:
         "",
         f"Speed-up (best of each): **{ross_best / ours_best:.0f}x**.",
     ]
-    out = ROOT / "benchmarks/campbell_ross.md"
+    out = ROOT / "benchmarks/results/campbell_ross.md"
     out.write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 

@@ -6,7 +6,7 @@ Prepares the paper scene, runs it for T_STATE seconds (default 0.5), and times a
 part of a Newton iterate (the model's residual, its tangent, the internal force and its tangent parts,
 every point force with and without its tangent, the von Mises maximum of an accepted step), each
 called many times in a row (milliseconds per call).  Parts that run alone stay in cache, so a part
-costs more inside the time loop than here (benchmarks/RESULTS.md, issue 17).
+costs more inside the time loop than here (docs/performance.md).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Monte Carlo throughput on 1 and 2 MPI ranks (issue 6): realisations per hour and parallel efficiency.
+"""Monte Carlo throughput on 1 and 2 MPI ranks: realisations per hour and parallel efficiency.
 
     .venv/bin/python benchmarks/mc_scaling.py [--samples 8] [--t-end 1.0]
 

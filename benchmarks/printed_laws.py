@@ -1,4 +1,4 @@
-"""Which printed law makes which published phenomenon (issue 15): 3 s of the nominal scene with the
+"""Which printed law makes which published phenomenon: 3 s of the nominal scene with the
 laws (18), (19), (21) as printed one at a time and together, with both kinematics.
 
     python benchmarks/printed_laws.py [--t-end 3] [--runs out/reproduction] [--table docs/printed_laws.md]

@@ -2,7 +2,7 @@
 test or table was tuned on (what a held-back check would do).
 
     python benchmarks/random_scenes.py [--scenes 8] [--seed 2026] [--t-end 1] [--runs out/random_scenes]
-                                       [--table benchmarks/random_scenes.md] [--jobs 2] [--lengths 30 250]
+                                       [--table benchmarks/results/random_scenes/random_scenes.md] [--jobs 2] [--lengths 30 250]
                                        [--set SECTION.KEY=VALUE ...]
 
 Draws each scene from the paper scene by changing its length, mesh, pipe radii, gap, drive speeds and bit-rock
@@ -64,7 +64,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=2026)
     parser.add_argument("--t-end", type=float, default=1.0)
     parser.add_argument("--runs", type=Path, default=Path("out/random_scenes"))
-    parser.add_argument("--table", type=Path, default=Path("benchmarks/random_scenes.md"))
+    parser.add_argument("--table", type=Path, default=Path("benchmarks/results/random_scenes/random_scenes.md"))
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--lengths", type=float, nargs=2, default=RANGES["length"], metavar=("LOW", "HIGH"),
                         help="the range of the string's length [m]")

@@ -1,6 +1,6 @@
-"""How far the reduced models are from the full order on the paper's scenes (issue 14's targets).
+"""How far the reduced models are from the full order on the paper's scenes.
 
-    python benchmarks/reduced_accuracy.py [--t-end 2] [--runs out/accuracy] [--table benchmarks/reduced_accuracy.md]
+    python benchmarks/reduced_accuracy.py [--t-end 2] [--runs out/accuracy] [--table benchmarks/results/reduced_accuracy.md]
 
 For the nominal scene with the objective kinematics and with the printed kinematics (wall impacts), it
 runs (or reuses, when ``RUNS/<name>/summary.json`` says the run finished) the full order
@@ -42,10 +42,10 @@ def run(name: str, overrides: list[str], t_end: float, runs: Path) -> dict:
 
 
 def main() -> None:
-    args = study_arguments(__doc__, 2.0, "out/accuracy", "benchmarks/reduced_accuracy.md")
+    args = study_arguments(__doc__, 2.0, "out/accuracy", "benchmarks/results/reduced_accuracy.md")
     lines = [f"# Reduced models against the full order: `{SCENE}`, t_end = {args.t_end} s", "",
              f"Command: `python benchmarks/reduced_accuracy.py --t-end {args.t_end}`. Relative differences from "
-             "the full order (500 elements, the same adaptive steps); targets of issue 14 in brackets.", ""]
+             "the full order (500 elements, the same adaptive steps).", ""]
     header = ("| kinematics | model | unknowns | steps | impacts | rop [m/h] | efficiency | mean bit velocity [m/h] "
               "| peak von Mises [MPa] | RMS bit velocity [m/h] | wall [s] | speed-up | time loop [s] | its speed-up |")
     lines += [header, "|" + "---|" * (header.count("|") - 1)]

@@ -1,4 +1,4 @@
-"""The paper's Section 6, as printed and consistent, side by side (issue 15; docs/reproduction.md).
+"""The paper's Section 6, as printed and consistent, side by side (docs/reproduction.md).
 
     python benchmarks/reproduction.py [--t-end 3] [--samples 32] [--ranks 2] [--runs out/reproduction]
                                       [--table docs/reproduction_numbers.md] [--figures docs/figures/reproduction]
@@ -178,7 +178,7 @@ def _mc_row(summary: dict) -> dict:
 
 def _table(title: str, rows: dict[str, dict]) -> list[str]:
     keys = list(dict.fromkeys(k for row in rows.values() for k in row))
-    lines = [f"### {title}", "", "| | " + " | ".join(rows) + " |", "|---|" + "---|" * len(rows)]
+    lines = [f"## {title}", "", "| | " + " | ".join(rows) + " |", "|---|" + "---|" * len(rows)]
     lines += [f"| {k} | " + " | ".join(row.get(k, "—") for row in rows.values()) + " |" for k in keys]
     return [*lines, ""]
 
@@ -186,7 +186,7 @@ def _table(title: str, rows: dict[str, dict]) -> list[str]:
 def _spectra_lines(args) -> list[str]:
     """The two highest peaks of every Section 6.8 signal, named against the free modes of the band and
     against the modes with u and theta_x held at x = 0 by the drive (spectra.json of each nominal run)."""
-    lines = ["### Spectral peaks (Figs. 21-23): peak [Hz] → nearest free mode / nearest mode held by the drive",
+    lines = ["## Spectral peaks (Figs. 21-23): peak [Hz] → nearest free mode / nearest mode held by the drive",
              "", "| signal | " + " | ".join(label for label, _, _ in NOMINALS.values()) + " |",
              "|---|" + "---|" * len(NOMINALS)]
     spectra = {name: json.loads(p.read_text()) if (p := args.runs / f"nominal-{name}" / "spectra.json").exists()
@@ -220,7 +220,7 @@ def write_report(args, costs: dict) -> None:
     lines += _table("Monte Carlo", rows)
     ran = {k: v for k, v in costs.items() if v > 0}
     if ran:
-        lines += ["### Wall time of the studies run by this invocation (2-core machine)", ""]
+        lines += ["## Wall time of the studies run by this invocation (2-core machine)", ""]
         lines += [f"- {k}: {v:.0f} s" for k, v in ran.items()] + [""]
     args.table.write_text("\n".join(lines))
     print("\n".join(lines))

@@ -1,6 +1,6 @@
-"""What runs cost before and after the speed work of issue 17, measured side by side in one sitting.
+"""What runs cost before and after a revision, measured side by side in one session.
 
-    python benchmarks/speed_table.py [--before 50d35ac] [--runs out/speed] [--table benchmarks/speed.md]
+    python benchmarks/speed_table.py [--before 50d35ac] [--runs out/speed] [--table benchmarks/results/speed.md]
 
 The revision ``--before`` is checked out with ``git worktree`` into RUNS/before-tree and run with the same
 interpreter as the working tree (its packages come first on sys.path), one run at a time on one core.
@@ -98,7 +98,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--before", default="50d35ac")
     parser.add_argument("--runs", type=Path, default=ROOT / "out/speed")
-    parser.add_argument("--table", type=Path, default=ROOT / "benchmarks/speed.md")
+    parser.add_argument("--table", type=Path, default=ROOT / "benchmarks/results/speed.md")
     args = parser.parse_args()
     runs = args.runs.resolve()
     runs.mkdir(parents=True, exist_ok=True)
@@ -108,7 +108,7 @@ def main() -> None:
     if not (before_tree / "fenics_drill/forms").exists():  # the weak forms ship as fenics_drill.forms (pyproject)
         shutil.copytree(before_tree / "forms", before_tree / "fenics_drill/forms")
     trees = {f"before ({args.before})": before_tree, "after": ROOT}
-    lines = [f"# Speed before and after issue 17 ({platform.processor() or platform.machine()}, "
+    lines = [f"# Speed before and after ({platform.processor() or platform.machine()}, "
              f"{os.cpu_count()} cores, one per run)", "",
              f"Command: `python benchmarks/speed_table.py --before {args.before}`. Accuracy: relative difference "
              "of rop / efficiency from the full order (500 elements, nominal step, same horizon). The Monte Carlo "

@@ -1,4 +1,4 @@
-"""The stick-slip maps of ``make stick-slip`` as Markdown tables (docs/drilling_control.md).
+"""The stick-slip maps of ``make stick-slip`` as Markdown tables (docs/guide/drilling_control.md).
 
     .venv/bin/python benchmarks/stick_slip_table.py out/stick-slip-stiff out/stick-slip-soft
 

@@ -1,6 +1,6 @@
-"""Speed against accuracy of every fidelity knob, on a scene of the user's choice (issue 8).
+"""Speed against accuracy of every fidelity knob, on a scene of the user's choice.
 
-    .venv/bin/python benchmarks/tradeoff.py [SCENE] [--t-end 0.5] [--workers 2] [--out benchmarks/tradeoff]
+    .venv/bin/python benchmarks/tradeoff.py [SCENE] [--t-end 0.5] [--workers 2] [--out benchmarks/results/tradeoff]
 
 Runs a converged reference (full order, fine mesh, small step) and a ladder of cheaper
 settings, each in its own process (so that peak memory is that variant's), and reports
@@ -24,13 +24,13 @@ from pathlib import Path
 import numpy as np
 
 #: name -> overrides; "reference" is the converged run every other is compared with.  The default is the
-#: 'auto' rule (the paper's bands with the stuck-bit torsional modes) with the guard's enrichment (issue 14);
+#: 'auto' rule (the paper's bands with the stuck-bit torsional modes) with the guard's enrichment;
 #: every knob below is changed alone from it.
 LADDER = {
     "reference: full order, 1000 elements, dt/4": ["reduction.rule='none'", "beam.elements=1000", "DT/4"],
     "full order, 500 elements, dt/4": ["reduction.rule='none'", "DT/4"],
     "full order, 500 elements, dt": ["reduction.rule='none'"],
-    "default: auto basis (59) + guard, 500 elements, dt, alpha 0.015": [],
+    "default: auto basis + guard, 500 elements, dt, alpha 0.015": [],
     "paper basis (44) + guard": ["reduction.rule='paper'"],
     "pure paper basis (enrich off)": ["reduction.rule='paper'", "reduction.enrich=false", "reduction.guard_tolerance=1"],
     "pure paper basis (enrich off), dt/4": ["reduction.rule='paper'", "reduction.enrich=false",
@@ -119,7 +119,7 @@ def main() -> None:
     parser.add_argument("scene", nargs="?", default="demos/scenes/paper.toml")
     parser.add_argument("--t-end", type=float, default=0.5)
     parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--out", type=Path, default=Path("benchmarks/tradeoff"))
+    parser.add_argument("--out", type=Path, default=Path("benchmarks/results/tradeoff"))
     args = parser.parse_args()
     from fenics_drill.scene import load_scene
     from fenics_drill.solvers.step_control import nominal_step

@@ -28,7 +28,7 @@ import h5py  # noqa: F401, E402
 
 from fenics_drill.scene import Scene, SceneError, load_scene  # noqa: E402
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 #: The API functions, imported on first use (``fenics-drill scene`` needs none of DOLFINx).
 _API = ("RunResult", "modal_analysis", "static_state", "run", "monte_carlo", "operating_window", "campbell", "plot")

@@ -15,6 +15,7 @@ import json
 import sys
 from pathlib import Path
 
+from fenics_drill import __version__
 from fenics_drill.scene import SceneError, load_scene, section_keys
 
 #: Commands run in a supervised worker process (single-process commands that can run long).
@@ -76,7 +77,7 @@ def cmd_static(args) -> int:
 
 def cmd_campbell(args) -> int:
     """Critical speeds: the modes of the spinning string over campbell.rotation_speed (DIR/campbell.json, .png)."""
-    from fenics_drill.plots.campbell import campbell_figure
+    from fenics_drill.plots.campbell import campbell_figure, crossing_text
     from fenics_drill.studies.campbell import write_campbell
 
     scene = load_scene(args.scene, args.overrides)
@@ -87,8 +88,7 @@ def cmd_campbell(args) -> int:
           f"compression {report['axial_force_N']:.4g} N [{report['wall_time_s']:.1f} s] -> "
           f"{Path(args.out) / 'campbell.json'}")
     for c in report["critical_speeds"]:
-        print(f"  critical speed {c['speed_rpm']:8.2f} rpm: {c['order']:g}x line meets a {c['whirl']} {c['kind']} "
-              f"branch at {c['frequency_hz']:.3f} Hz")
+        print(f"  critical speed {c['speed_rpm']:8.2f} rpm: {crossing_text(c)} at {c['frequency_hz']:.3f} Hz")
     return 0
 
 
@@ -197,6 +197,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="fenics-drill",
         description="Nonlinear dynamics of horizontal drillstrings (Cunha Jr, Soize, Sampaio 2015) on FEniCSx.",
     )
+    parser.add_argument("--version", action="version", version=f"fenics-drill {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("scene", help="validate a scene and print it with all defaults")
     _scene_args(p, out=False)

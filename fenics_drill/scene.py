@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -69,9 +70,7 @@ def _band_or_count(doc: str):
 @dataclass(frozen=True)
 class Beam:
     length: float = _pos("beam length L [m]", 100.0)
-    elements: int = key(250, "number of finite elements [-]; 250 sits on the Pareto front of the modal "
-                        "models (the paper's 500 gives the same drilling quantities to 5 digits at 1.7x the cost, "
-                        "benchmarks/RESULTS.md); the full order needs 500-1000", lambda n: n >= 1, ">= 1")
+    elements: int = key(250, "number of finite elements [-]", lambda n: n >= 1, ">= 1")
     element_degree: int = key(2, "polynomial degree of u, v, w; the rotations use one degree less [-]",
                               lambda k: 2 <= k <= 5, "an integer in [2, 5]")
     outer_radius: float = _pos("outer radius R_ext [m]", 80e-3)
@@ -103,15 +102,10 @@ class Contact:
                                   "(as model.laws says)", choices=("model", "consistent", "printed"))
     friction_torque_law: str = key("model", "the friction torque (19): 'consistent', 'printed', or 'model' "
                                    "(as model.laws says)", choices=("model", "consistent", "printed"))
-    damper_law: str = key("consistent", "the damper of (17): 'consistent' (c |delta|^3 delta_dot, a force) or "
-                          "'printed' (c |delta_dot|^3 delta_dot as printed, not a force's unit: docs/errata.md), "
-                          "or 'model' (as model.laws says)", choices=("model", "consistent", "printed"))
-    sliding_velocity_scale: float = _pos(
-        "v_s of the regularised sgn(v) = tanh(v / v_s) in (18)-(19), applied to the axial velocity "
-        "and to the surface speed R_bh theta_x_dot [m/s]", 1e-3)
-    culling: bool = key(True, "evaluate the wall law only at the vertices that can reach the wall (exact: a bound "
-                        "on the motion since the last check proves the others cannot); false: at every vertex")
-
+    damper_law: str = key("consistent", "the damper of (17): 'consistent' (c |delta|^3 delta_dot), 'printed' or "
+                          "'model'", choices=("model", "consistent", "printed"))
+    sliding_velocity_scale: float = _pos("v_s of the regularised sgn(v) = tanh(v / v_s) in (18)-(19) [m/s]", 1e-3)
+    culling: bool = key(True, "evaluate the wall law only where a vertex can reach the wall (exact)")
 
 @dataclass(frozen=True)
 class BitRock:
@@ -120,9 +114,8 @@ class BitRock:
     friction: float = key(0.4, "mu_BR of Eq. (21) [-]", lambda x: 0 <= x <= 1, "in [0, 1]")
     torque_law: str = key("model", "the bit torque (21): 'consistent', 'printed', or 'model' (as model.laws says)",
                           choices=("model", "consistent", "printed"))
-    law: str = key("paper", "bit-rock law: 'paper' (the velocity law (20)-(22)) or 'detournay' (cutting and "
-                   "frictional contact with the regenerative depth of cut, Richard, Germay & Detournay 2007: "
-                   "fenics_drill/model/forces/cutting_bit.py)", choices=("paper", "detournay"))
+    law: str = key("paper", "bit-rock law: 'paper' (velocity law (20)-(22)) or 'detournay' (cutting law)",
+                   choices=("paper", "detournay"))
     bit_radius: float = _pos("'detournay': bit radius a [m]", 95e-3)
     blades: int = key(4, "'detournay': number of blades n [-]", _positive, ">= 1")
     specific_energy: float = _pos("'detournay': intrinsic specific energy epsilon of the rock [Pa]", 60e6)
@@ -130,26 +123,19 @@ class BitRock:
     contact_strength: float = _nonneg("'detournay': contact strength sigma under the wear flats [Pa]", 60e6)
     wear_flat_length: float = _nonneg("'detournay': total wear-flat length l [m]", 1.2e-3)
     geometry_factor: float = _pos("'detournay': bit geometry factor gamma of the contact torque [-]", 1.0)
-    contact_velocity: float = _pos("'detournay': regularisation of the set-valued contact: the contact force "
-                                   "grows from 0 to sigma a l as u_dot_bit goes from 0 to this, and the torque "
-                                   "changes sign over this surface speed a omega_bit [m/s]", 1e-4)
-    contact_depth: float = _pos("'detournay': regularisation of lift-off: the contact force grows from 0 to "
-                                "sigma a l as the depth of cut goes from 0 to this [m]", 1e-5)
-
+    contact_velocity: float = _pos("'detournay': velocity scale of the regularised wear-flat contact [m/s]", 1e-4)
+    contact_depth: float = _pos("'detournay': depth of cut over which the wear-flat contact builds up [m]", 1e-5)
 
 @dataclass(frozen=True)
 class Drive:
     axial_velocity: float = key(1.0 / 180.0, "V0, imposed axial velocity at x = 0 [m/s]")
     rotation_speed: float = key(2.0 * math.pi, "Omega, imposed rotation speed at x = 0 (the set speed of a "
                                 "controller) [rad/s]")
-    mode: str = key("velocity", "axial drive: 'velocity' (u(0) = V0 t, the paper) or 'hook_load' (the top "
-                    "pushes with drive.weight_on_bit; V0 is the initial feed)", choices=("velocity", "hook_load"))
-    weight_on_bit: float = _pos("'hook_load': set weight on bit [N]; the hook load is the string's axial weight "
-                                "component (none in this horizontal hole) minus it", 25e3)
-    controller: str = key("stiff", "rotary drive: 'stiff' (theta_x(0) = Omega t, the paper), 'pi' (top drive "
-                          "with a PI speed controller, drive.proportional_gain and drive.integral_gain) or "
-                          "'soft_torque' (the PI tuned to the pipe's torsional impedance, "
-                          "fenics_drill/model/top_drive.py)", choices=("stiff", "pi", "soft_torque"))
+    mode: str = key("velocity", "axial drive: 'velocity' (u(0) = V0 t) or 'hook_load' (push with drive.weight_on_bit)",
+                    choices=("velocity", "hook_load"))
+    weight_on_bit: float = _pos("'hook_load': set weight on bit [N]", 25e3)
+    controller: str = key("stiff", "rotary drive: 'stiff' (theta_x(0) = Omega t), 'pi' or 'soft_torque' (top drive)",
+                          choices=("stiff", "pi", "soft_torque"))
     top_drive_inertia: float = _pos("'pi', 'soft_torque': rotary inertia J_td of the top drive [kg m^2]", 500.0)
     proportional_gain: float = _nonneg("'pi': k_p of the speed controller [N m s/rad]", 5e4)
     integral_gain: float = _nonneg("'pi': k_i of the speed controller [N m/rad]", 5e5)
@@ -159,25 +145,15 @@ class Drive:
 @dataclass(frozen=True)
 class Time:
     t_end: float = _pos("end of the simulated interval [s]", 10.0)
-    dt: float = key(-1.0, "nominal time step [s]; -1: 1/(time.band_steps f_max) with f_max = f*_max c_L / L",
+    dt: float = key(-1.0, "nominal time step; -1: 1/(time.band_steps f_max), f_max = f*_max c_L / L [s]",
                     lambda x: x == -1.0 or x > 0, "> 0 (or -1 for the nominal step of time.band_steps)")
-    band_steps: float = key(8.0, "steps per period of the band's highest frequency f_max in the nominal step "
-                            "(time.dt = -1) [-]; 2 is the paper's step 1/(2 f_max) of Section 6.2, which leaves "
-                            "the efficiency (96) 4-7 % high against the step-converged full order: the drive "
-                            "torque's oscillation, which (98) counts only while it drives, is not resolved. "
-                            "8 leaves 0.3-0.6 % on 30-50 m strings and 0.35 % on the paper scene over 10 s "
-                            "(against the same model with the bit's transitions resolved); a smaller step of "
-                            "the full order resolves frequencies above the band, whose efficiency is lower "
-                            "(docs/verification.md)", lambda x: x >= 2.0, ">= 2 (Nyquist)")
+    band_steps: float = key(8.0, "steps per period of f_max in the nominal step (2: the paper's 1/(2 f_max)) [-]",
+                            lambda x: x >= 2.0, ">= 2 (Nyquist)")
     newmark_alpha: float = key(0.015, "alpha of Newmark's gamma = 1/2 + alpha, beta = (1/2 + gamma)^2 / 4 "
                                "(Section 4.3) [-]", lambda x: 0 <= x <= 0.5, "in [0, 0.5]")
     adaptive: bool = key(True, "refine the step where the local error estimate exceeds time.error_tolerance")
-    error_tolerance: float = _pos("admissible local error per step of the lateral vertex displacements and of the bit's axial displacement and surface arc r theta_x [m]", 1e-5)
-    start_up_share: float = key(0.01, "share of time.error_tolerance admitted over the first nominal step, the "
-                                "start-up transient: the bit, set moving at V0 and Omega at t = 0, is braked by the "
-                                "rock within microseconds, and an error there stays in the lightly damped string as "
-                                "an oscillation (at 1 it moved the 1 s efficiency of 15-25 m strings by 1.5-9 %, "
-                                "docs/verification.md); 1: the tolerance of the other steps [-]",
+    error_tolerance: float = _pos("admissible local error per step of the displacements watched [m]", 1e-5)
+    start_up_share: float = key(0.01, "share of time.error_tolerance admitted over the first nominal step [-]",
                                 lambda x: 0 < x <= 1, "in (0, 1]")
     max_step_cuts: int = key(12, "the smallest step is dt / 2^max_step_cuts; a run needing less stops [-]",
                              lambda n: 0 <= n <= 40, "an integer in [0, 40]")
@@ -187,17 +163,14 @@ class Time:
 class Solver:
     newton_tolerance: float = _pos("relative residual at which Newton stops [-]", 1e-8)
     newton_max_iterations: int = key(25, "Newton iterations before the step is cut [-]", _positive, ">= 1")
-    tangent_reuse: int = key(20, "steps over which the assembled internal tangent is reused; 1: fresh at "
-                             "every step (contact and bit tangents are always fresh) [-]", _positive, ">= 1")
-    compiled_step: bool = key(True, "take a modal model's Newmark steps that keep their tangent in one compiled "
-                              "call (the same Newton, solvers/compiled_step.py); false: every step in Python")
-
+    tangent_reuse: int = key(20, "steps over which the assembled internal tangent is reused [-]", _positive, ">= 1")
+    compiled_step: bool = key(True, "take a modal model's steps that keep their tangent in one compiled call")
 
 @dataclass(frozen=True)
 class Output:
-    section: float = key(-1.0, "x of the cross-section whose lateral motion is recorded [m]; -1: mid-length L/2",
+    section: float = key(-1.0, "x of the section whose lateral motion is recorded; -1: mid-length L/2 [m]",
                          lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for L/2)")
-    field_interval: float = _nonneg("simulated time between XDMF field snapshots [s]; 0: no fields", 0.1)
+    field_interval: float = _nonneg("simulated time between XDMF field snapshots; 0: no fields [s]", 0.1)
     von_mises: bool = key(True, "record the maximum von Mises stress over the string at every step (Eq. 100)")
 
 
@@ -210,17 +183,12 @@ class Model:
     bit_rock: bool = key(True, "evaluate the bit-rock force and torque (20)-(22)")
     geometric_nonlinearity: bool = key(True, "assemble the geometric nonlinear force F_SE (49)")
     inertial_nonlinearity: bool = key(True, "assemble the inertial nonlinear force F_KE (48)")
-    laws: str = key("consistent", "friction (18), (19) and bit torque (21): 'consistent' (they never do positive "
-                     "work, docs/errata.md) or 'printed' (as printed: with F_n, F_BR <= 0 they inject energy); each "
-                     "law can also be set alone (contact.axial_friction_law, contact.friction_torque_law, "
-                     "bit_rock.torque_law)", choices=("consistent", "printed"))
-    kinematics: str = key("objective", "cross-section kinematics of the strain energy: 'objective' (strains "
-                          "unchanged by a rigid spin theta_x, docs/errata.md) or 'printed' (Eq. 14 as printed)",
+    laws: str = key("consistent", "friction (18), (19) and bit torque (21): 'consistent' or 'printed'",
+                    choices=("consistent", "printed"))
+    kinematics: str = key("objective", "section kinematics of the strain energy: 'objective' or 'printed' (14)",
                           choices=("objective", "printed"))
-    angular_velocity: str = key("consistent", "angular velocity of the section in the kinetic energy (24): "
-                                "'consistent' (tilts about the inertial axes: a spinning shaft's forward whirl "
-                                "stiffens, docs/errata.md) or 'printed' (Eq. 13 as printed: the gyroscopic "
-                                "coupling reversed)", choices=("consistent", "printed"))
+    angular_velocity: str = key("consistent", "angular velocity in the kinetic energy (24): 'consistent' or "
+                                "'printed' (13)", choices=("consistent", "printed"))
 
 
 def _positions(x) -> bool:
@@ -231,8 +199,8 @@ def _positions(x) -> bool:
 class Supports:
     """Lateral supports besides the ends of ``model.supports``."""
 
-    stabilisers: tuple = key((), "x of pinned lateral supports, like stabilisers: v = w = 0 at the mesh vertex "
-                             "nearest each, 0 < x < beam.length [m]", _positions, "a list of numbers")
+    stabilisers: tuple = key((), "x of pinned lateral supports (v = w = 0 at the nearest vertex) [m]",
+                             _positions, "a list of numbers")
 
 
 @dataclass(frozen=True)
@@ -242,45 +210,24 @@ class Modal:
 
 @dataclass(frozen=True)
 class Reduction:
-    rule: str = key("auto", "'auto' (flexural modes up to 5 x the spin frequency, torsional and axial ones up to "
-                    "what the time step resolves, plus the torsional modes of a stuck bit: "
-                    "fenics_drill/model/reduction/modes.py), 'paper' (Section 6.3 as printed, Table 4), 'band' (f* upper "
-                    "bounds per family), 'count' (number of modes per family) or 'none' (full order)",
+    rule: str = key("auto", "reduced basis: 'auto', 'paper' (Table 4), 'band', 'count' or 'none' (full order)",
                     choices=("auto", "paper", "band", "count", "none"))
-    flexural: float = _band_or_count("flexural f* upper bound ('band') or mode count ('count')")
-    torsional: float = _band_or_count("torsional f* upper bound ('band') or mode count ('count')")
-    axial: float = _band_or_count("axial f* upper bound ('band') or mode count ('count')")
-    enrich: bool = key(True, "add to the basis the static response of every load it misses beyond "
-                       "reduction.guard_tolerance, with its axial companion (fenics_drill/model/reduction/enrichment.py); "
-                       "false: a basis missing a load beyond the tolerance stops the command")
-    axial_companions: bool = key(False, "also check and add the axial companion (static modal derivative) of "
-                                 "each load's response: off by default, the static state carries the large "
-                                 "deflections and the companions spoil the bit dynamics (benchmarks/"
-                                 "reduced_accuracy.md)")
-    hyper: bool = key(True, "evaluate the nonlinear internal forces (48)-(49) of a modal basis on a weighted sample of "
-                      "elements (ECSW, fenics_drill/model/reduction/hyper_reduction.py), trained on a short run of the "
-                      "unsampled model; false: on every element")
+    flexural: float = _band_or_count("flexural f* upper bound ('band') or mode count ('count') [-]")
+    torsional: float = _band_or_count("torsional f* upper bound ('band') or mode count ('count') [-]")
+    axial: float = _band_or_count("axial f* upper bound ('band') or mode count ('count') [-]")
+    enrich: bool = key(True, "add the static responses the basis misses; false: refuse such a basis")
+    axial_companions: bool = key(False, "also add each load response's axial companion (static modal derivative)")
+    hyper: bool = key(True, "evaluate the nonlinear forces (48)-(49) on an ECSW element sample")
     hyper_tolerance: float = key(1e-4, "relative error of the sampled projected nonlinear forces on the training "
                                  "states [-]", lambda x: 0 < x < 1, "in (0, 1)")
     hyper_training: float = _pos("simulated time of the training run of the element sample [s]", 0.1)
-    out_of_band_damping: float = key(0.1, "modal damping ratio given to the directions a modal basis spans above "
-                                     "2 f_max, with the wall's springs at rest (the stuck-bit modes and the guard's "
-                                     "vectors combine into a light, "
-                                     "stiff twist of the bit, which rang against the bit law's falling torque; "
-                                     "0.1 stops it, 1 moved some efficiencies by 0.6-0.9 %: "
-                                     "fenics_drill/model/reduction/out_of_band_damping.py); 0: none [-]",
+    out_of_band_damping: float = key(0.1, "damping ratio of the basis's directions above 2 f_max [-]",
                                      lambda x: 0 <= x <= 10, "in [0, 10]")
-    guard_tolerance: float = key(0.03, "largest admissible share of a load's static response the basis may miss "
-                                 "(square root of the missed strain-energy share; 0.03 = 0.1 % of the energy); 1 "
-                                 "accepts any basis (the paper's pure modal basis with enrich = false)",
+    guard_tolerance: float = key(0.03, "largest share of a load's static response the basis may miss [-]",
                                  lambda x: 0 < x <= 1, "in (0, 1]")
+    rest_response_tolerance: float = key(0.01, "largest share of the responses at rest the basis may miss [-]",
+                                         lambda x: 0 < x <= 1, "in (0, 1]")
 
-    rest_response_tolerance: float = key(0.01, "largest admissible share of the responses of the string at rest "
-                                         "(its tangent, with the wall's springs) to the bit force and torque and "
-                                         "the wall's friction that the basis may miss (square root of the energy "
-                                         "share); they carry the bending at the touchdown on the wall, where a "
-                                         "pinned string's peak stress sits (fenics_drill/studies/prepare.py); "
-                                         "1: none added", lambda x: 0 < x <= 1, "in (0, 1]")
 
 @dataclass(frozen=True)
 class Uncertainty:
@@ -292,7 +239,7 @@ class Uncertainty:
                                         _gamma_dispersion, "in [0, 1/sqrt(2)) (Eq. 86)")
     friction_dispersion: float = _nonneg("dispersion sigma/m of mu_BR, beta law (90)-(92); with mean m it must "
                                          "be < sqrt((1 - m)/m) [-]", 0.005)
-    seed: int = key(20150101, "base seed: realisation k draws from numpy default_rng([seed, k])",
+    seed: int = key(20150101, "base seed: realisation k draws from numpy default_rng([seed, k]) [-]",
                     _non_negative, ">= 0")
     output_interval: float = _pos("step of the common time grid of the Monte Carlo histories [s]", 0.01)
 
@@ -314,8 +261,7 @@ class Optimize:
                                 "[rad/s]", _grid_axis, _GRID)
     objective: str = key("rop", "what to maximise: 'rop' (99) or 'efficiency' (96)", choices=("rop", "efficiency"))
     ultimate_strength: float = _pos("UTS of the von Mises constraint (100), (103) [Pa]", 650e6)
-    samples: int = key(0, "realisations per grid point: 0 = deterministic (nominal bit-rock), "
-                       "N > 0 = robust, E[objective] (102) under the chance constraint (103)-(104)",
+    samples: int = key(0, "realisations per grid point: 0 deterministic, N > 0 robust (102)-(104) [-]",
                        lambda n: 0 <= n <= MAX_SAMPLES, f"in [0, {MAX_SAMPLES}]")
     risk: float = key(0.1, "P_risk of the chance constraint (104) [-]", lambda x: 0 < x < 1, "in (0, 1)")
 
@@ -332,13 +278,10 @@ class Campbell:
                                 _grid_axis, _GRID)
     modes: int = key(12, "lowest whirl frequencies followed at each speed [-]", lambda n: 1 <= n <= 500,
                      "in [1, 500]")
-    state: str = key("straight", "what the modes are linearised about: 'straight' (the straight string, gravity "
-                     "and wall left out) or 'static' (the static equilibrium on the wall under gravity, with the "
-                     "linearised wall stiffness)", choices=("straight", "static"))
-    axial_force: float = key(0.0, "axial compression at the bit [N], applied before linearising (geometric "
-                             "stiffness); see campbell.weight_on_bit")
-    weight_on_bit: bool = key(False, "true: the axial compression is the steady bit force of Eq. (20) at the "
-                              "drive's V0 (the weight on bit of a run), instead of campbell.axial_force")
+    state: str = key("straight", "linearised about: 'straight' (no gravity, no wall) or 'static' (on the wall)",
+                     choices=("straight", "static"))
+    axial_force: float = key(0.0, "axial compression at the bit before linearising [N]")
+    weight_on_bit: bool = key(False, "compress with the steady bit force (20) at V0 instead of campbell.axial_force")
     excitation_orders: tuple = key((1.0, 3.0), "orders n of the excitation lines f = n Omega / 2 pi (1: unbalance, "
                                    "n: an n-bladed bit) [-]", _orders, "a non-empty list of numbers > 0")
     damping: bool = key(False, "include the dissipation (38): damped frequencies and damping ratios")
@@ -551,3 +494,33 @@ def load_scene(path: str | Path | None = None, overrides: list[str] | tuple[str,
             raise SceneError(f"[{section}] must be a table of keys")
         raw[section][name] = value
     return validate(raw)
+
+
+@dataclass(frozen=True)
+class KeyDescription:
+    """One scene key as the manual and ``fenics-drill scene`` show it."""
+
+    section: str
+    name: str
+    kind: str
+    default: Any
+    unit: str
+    admissible: str
+    meaning: str
+
+
+def describe_keys() -> list[KeyDescription]:
+    """Every scene key in file order: its type, default, unit (the doc's trailing ``[...]``), admissible set, meaning."""
+    rows = []
+    for section in SECTIONS:
+        kinds = get_type_hints(SECTIONS[section])
+        for name, f in section_keys(section).items():
+            meta, doc = f.metadata, f.metadata["doc"]
+            unit = ""
+            match = re.search(r"\s*\[([^\[\]]*)\]$", doc)
+            if match:
+                unit, doc = match.group(1), doc[: match.start()]
+            admissible = meta["admissible"] or (" | ".join(repr(c) for c in meta["choices"]) if meta["choices"] else "")
+            default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+            rows.append(KeyDescription(section, name, _describe_kind(kinds[name]), default, unit, admissible, doc))
+    return rows

@@ -5,7 +5,7 @@ Kinetic energy (23)-(24) with the angular velocity (13); Green-Lagrange strains
 strain energy (30) integrated exactly over the annulus; dissipation function (38).
 
 The generalised forces follow Lagrange's equations.  With U, V, A the
-displacement, velocity and acceleration coefficients:
+displacement, velocity and acceleration coefficients::
 
     inertial(psi) = d/dt dT/dV [psi] - dT/dU [psi]
                   = D_U(dT/dV[psi])[V] + D_V(dT/dV[psi])[A] - dT/dU[psi]

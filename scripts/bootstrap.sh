@@ -36,6 +36,6 @@ if [ ! -x "$VENV/bin/python" ] || ! good "$VENV/bin/python" >/dev/null; then
 fi
 if [ ! -f "$STAMP" ] || [ pyproject.toml -nt "$STAMP" ]; then
   "$VENV/bin/python" -m pip install --quiet --upgrade pip
-  "$VENV/bin/python" -m pip install --quiet -e ".[test]"
+  "$VENV/bin/python" -m pip install --quiet -e ".[test,docs]"
   touch "$STAMP"
 fi

@@ -106,3 +106,28 @@ def test_every_force_lives_in_its_own_module_and_is_registered():
         alternatives = [force for force in FORCES if force.name == name]
         if len(alternatives) > 1:
             assert all(hasattr(force, "chosen") for force in alternatives), name
+
+
+def test_no_import_cycle():
+    """Following every import between the package's modules never leads back to where it started."""
+    graph = {module: set() for module, _ in modules()}
+    for module, path in modules():
+        for name in imported_modules(path):
+            target = name if name in graph else next((m for m in graph if name.startswith(m + ".")), None)
+            if target is not None and target != module:
+                graph[module].add(target)
+    state, cycles = {}, []
+
+    def visit(module, trail):
+        state[module] = "open"
+        for target in graph[module]:
+            if state.get(target) == "open":
+                cycles.append(trail[trail.index(target):] + [target])
+            elif target not in state:
+                visit(target, trail + [target])
+        state[module] = "done"
+
+    for module in graph:
+        if module not in state:
+            visit(module, [module])
+    assert not cycles, cycles

@@ -87,7 +87,7 @@ class BeamDiscretization:
         return out
 
     def end_dof(self, field: int, end: int) -> int:
-        """Index of the dof of ``field`` sitting at x = 0 (end=0) or x = L (end=1)."""
+        """Index of the dof of ``field`` at x = 0 (end=0) or x = L (end=1)."""
         x_end = 0.0 if end == 0 else self.properties.length
         vertices = mesh.locate_entities_boundary(self.mesh, 0, lambda x: np.isclose(x[0], x_end))
         dofs = fem.locate_dofs_topological(self.V.sub(field), 0, vertices)

@@ -112,7 +112,7 @@ class DrillstringModel:
         Ritz directions of :meth:`resting_stiffness`.  On the wall the springs stiffen the directions that press
         the resting vertices into it far above f_max, and these rang against the contact where the full order's
         local contact dynamics is damped by Newmark's alpha (a thin pipe between stabilisers lifted off and
-        bounced; docs/verification.md, "Stabilisers").  The model itself if :meth:`resting_stiffness` is None."""
+        bounced; docs/verification.md, "The reduced model against its full order").  The model itself if :meth:`resting_stiffness` is None."""
         stiffness = self.resting_stiffness(q)
         if stiffness is None:
             return self

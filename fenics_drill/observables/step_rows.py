@@ -53,8 +53,8 @@ class StepRows:
     What a step's record alone knows (its time, multipliers, works, the forces' records) is read when
     the step is taken; what follows from its state (the bit and section values, the von Mises maximum
     over the string) is computed for BATCH steps together, with one product of [Phi] with all their
-    states instead of one per step (benchmarks/RESULTS.md, item 35), and its kinetic and strain energies
-    are read from the budget, which computes them in batches too (item 62)."""
+    states instead of one per step (docs/performance.md), and its kinetic and strain energies
+    are read from the budget, which computes them in batches too."""
 
     #: Steps whose state observables are computed together.
     BATCH = 64

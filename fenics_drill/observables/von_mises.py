@@ -30,7 +30,7 @@ displacements and P1 rotations the linear strains are affine along an element, s
 outer fibre sigma_VM, the norm of an affine function of x, is convex and largest at an end of the element;
 the midpoint can hold more only through the strains' quadratic terms.  Measured on random states from 1e-5 to
 1e-1 (m, rad) of every field, for each strain model, it never did (tests/observables/test_observables.py),
-and the probe costs a third less (benchmarks/RESULTS.md, item 63).
+and the probe costs a third less (docs/performance.md).
 """
 
 from __future__ import annotations

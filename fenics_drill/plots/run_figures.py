@@ -53,13 +53,16 @@ def time_series_figures(data: dict, attrs: dict, out: Path) -> list[Path]:
     ax.set(xlabel="time [s]", ylabel="radial displacement [mm]", title=f"Fig. 17: radial displacement at x = {x_s:g} m")
     ax.legend(loc="lower right")
     paths.append(save_figure(fig, out / "fig17_section_radial.png"))
-    paths.append(_time_pair(out / "fig18_impacts_time.png", t, data["impacts"], data["vertices_in_contact"],
-                            ("impacts per step", "vertices in contact"), "Fig. 18: wall impacts against time"))
+    path18 = _time_pair(out / "fig18_impacts_time.png", t, data["impacts"], data["vertices_in_contact"],
+                        ("impacts per step [-]", "vertices in contact [-]"), "Fig. 18: wall impacts against time")
     fig, (ax,) = panels(1, 3.5)
-    x = data["vertex_x"]
-    ax.bar(x, data["impacts_per_vertex"], width=x[1] - x[0])
-    ax.set(xlabel="x [m]", ylabel="impacts", title="Fig. 19: wall impacts per vertex", xlim=(x[0], x[-1]))
-    paths.append(save_figure(fig, out / "fig19_impacts_position.png"))
+    x, per_vertex = data["vertex_x"], data["impacts_per_vertex"]
+    ax.bar(x, per_vertex, width=x[1] - x[0])
+    ax.set(xlabel="x [m]", ylabel="impacts [-]", title="Fig. 19: wall impacts per vertex", xlim=(x[0], x[-1]),
+           ylim=(0, max(1.0, 1.05 * float(np.max(per_vertex)))))
+    if not np.any(per_vertex):
+        ax.text(0.5, 0.5, "no impact in this run", transform=ax.transAxes, ha="center", va="center", color="0.4")
+    paths += [path18, save_figure(fig, out / "fig19_impacts_position.png")]
     return paths
 
 

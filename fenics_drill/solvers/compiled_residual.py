@@ -1,8 +1,7 @@
 """The residual (65) of a modal model with the usual forces, in one compiled call.
 
 :meth:`DrillstringModel.evaluate` runs each force's kernel from Python and sums their loads there; at the
-paper scene's two evaluations per step that glue costs about as much as the kernels (benchmarks/RESULTS.md,
-items 76-77).  :func:`residual_at` runs the same kernels (the sampled internal force of
+paper scene's two evaluations per step that glue costs about as much as the kernels (docs/performance.md).  :func:`residual_at` runs the same kernels (the sampled internal force of
 :mod:`~fenics_drill.model.kernels.cell_kernels`, the wall's :func:`~fenics_drill.model.forces.wall_contact._modal_pass`,
 the bit law (20)-(22)) and the same sums, in the same order, for the compiled Newton step of
 :mod:`fenics_drill.solvers.compiled_step`.

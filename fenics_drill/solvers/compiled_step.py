@@ -3,7 +3,7 @@
 Most of the paper scene's steps (86 % over 3 s; 66 % with the printed kinematics) take the tangent that the
 step before them ended with and converge in two evaluations (solvers/newmark.py, CARRY_WITHIN); most of the
 others form one at their predictor and keep it.  In Python their evaluations, tests and updates cost about as
-much as their kernels (benchmarks/RESULTS.md, item 77).  :func:`kept_tangent_step` takes such a step as
+much as their kernels (docs/performance.md).  :func:`kept_tangent_step` takes such a step as
 :meth:`NewmarkNewton.step` does, with its tangent's LU kept: the predictor, the residual
 (:func:`~fenics_drill.solvers.compiled_residual.residual_at`), the convergence test, the settle test, the full update
 and its sufficient decrease, and the contraction test that keeps the tangent.  Where that Newton would do

@@ -18,7 +18,7 @@ terms; with alpha > 0 the budget also shows Newmark's numerical dissipation.
 
 The kinetic and strain energies of the accepted states are computed for BATCH states at once
 (:meth:`EnergyBudget.defer`), in one compiled call per energy: at every step they cost as much as a model
-evaluation (benchmarks/RESULTS.md, item 62).  Whatever reads them settles the pending states first.
+evaluation (docs/performance.md).  Whatever reads them settles the pending states first.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ a 20 mm gap: at most 1.2e-8 m over 1 s of a 100 m string, 9.2e-8 m over 0.3 s of
 then lift by a few micrometres at micrometres per second.  Counted as impacts, those contacts made a resting
 string report impacts at a rate set by the mesh and the time step (3 to 541 in one second of the same scene).
 An onset counts as an impact only when the vertex had moved clear of the wall by more than IMPACT_CLEARANCE
-of the gap since its last contact (docs/verification.md, "Impacts").
+of the gap since its last contact (docs/verification.md, "Observables").
 """
 
 from __future__ import annotations

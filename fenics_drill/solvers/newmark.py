@@ -29,14 +29,14 @@ TANGENT_REUSE_RATE = 0.1
 #: next one.  It is the part that drifts between the periodic refreshes: the spin turns the stiffness of a
 #: deflected string, and the printed kinematics' strains turn with theta_x itself; df/dqd and df/dqdd are kept
 #: up to ``tangent_reuse`` steps (measured: the same Newton iterations as a refresh of all three, at a third
-#: of the assembly; benchmarks/RESULTS.md, issue 17, item 52).
+#: of the assembly; docs/performance.md).
 SLOW_CONTRACTION = 0.25
 #: An iterate is the step's result, without another evaluation, when Newton's next update would move no point
 #: of the string's surface by more than this share of time.error_tolerance (the role of kappa in Hairer &
 #: Wanner's stopping test, Sec. IV.8, there 0.01-0.1; here smaller, for the efficiency (96), which rectifies
 #: the drive torque).  In a modal space, against 1e-4: the paper scene's 10 s and ten random scenes give the same
 #: rop, efficiency and peak stress to 1e-5 (the paper scene's full order over 1 s and 3 s moved by 3e-5 and 7e-5),
-#: for 7 % fewer evaluations (benchmarks/RESULTS.md, items 53, 60 and 65) ...
+#: for 7 % fewer evaluations (docs/performance.md) ...
 SETTLED_SHARE = 1e-3
 #: ... and in the full space this share.  There every vertex on the wall is a mass on its own spring
 #: (k_FS1 = 1e10 N/m), and a vertex left 1e-8 m from its converged place carries a force error of 100 N, about the
@@ -44,7 +44,7 @@ SETTLED_SHARE = 1e-3
 #: bounced thousands of times, which their refined runs and the reduced models do not; at 1e-4 one of the five
 #: scenes found still was (a light pipe, 130 N per vertex).  At 1e-5 and 1e-6 all five rest, with the same rop,
 #: efficiency and peak stress to 1e-4; the paper scene's full order takes 12 % more evaluations than at 1e-3
-#: (docs/verification.md, "Newton's stopping test and the wall"; benchmarks/RESULTS.md, item 65).
+#: (docs/verification.md, "The reduced model against its full order"; docs/performance.md).
 SETTLED_SHARE_FULL = 1e-5
 #: ... and each of the drive's multipliers by less than this share of the largest it has been: four orders
 #: below the 1 % that the efficiency, which reads the drive torque lambda_4, is asked to meet ...
@@ -57,7 +57,7 @@ SETTLED_CONTRACTION = 0.5
 #: and this one converged within this many evaluations (its tangent still described the motion well); the
 #: rate test of TANGENT_REUSE_RATE then judges it.  Measured on the paper scene's 10 s: 5 % less wall time at
 #: 5 % more evaluations, the same rop and efficiency; carried after any step, 16 % more evaluations for the
-#: same time (benchmarks/RESULTS.md, item 59).
+#: same time (docs/performance.md).
 CARRY_WITHIN = 2
 
 #: The predictor's forces of a compiled step that evaluates them itself.
@@ -223,7 +223,7 @@ class NewmarkNewton:
             step's error and the efficiency may be (SETTLED_SHARE, SETTLED_FORCE_SHARE): the iterate whose
             residual is still above the tolerance need not be moved and evaluated once more.  Measured: a
             quarter of the paper scene's evaluations saved, its efficiency unchanged to 1e-5
-            (benchmarks/RESULTS.md, item 53)."""
+            (docs/performance.md)."""
             if self.settle_length is None or len(norms) < 2 or norms[-1] > SETTLED_CONTRACTION * norms[-2]:
                 return None
             if not self._moves_less_than(dq, self.settled_share * self.settle_length):

@@ -14,13 +14,13 @@ bit-rock laws (20)-(21) act: the start-up from rest onto the rock and each stick
 transition).  An impact or a bit transient makes the acceleration jump, the estimate
 grows and the step shrinks; once the motion is smooth again the step relaxes back to
 the nominal one.  Without the bit's rows a reduced model takes the start-up in one
-nominal step, and its bit velocity rings (benchmarks/reduced_accuracy.md).  A Newton
+nominal step, and its bit velocity rings (benchmarks/results/reduced_accuracy.md).  A Newton
 failure halves the step; after ``time.max_step_cuts`` halvings the run stops.
 
 Over the first nominal step the tolerance is ``time.start_up_share`` of ``time.error_tolerance``: the bit,
 set moving at V0 and Omega at t = 0, is braked by the rock law's steep velocity dependence within
 microseconds, and what error that transient leaves stays in the string as a lightly damped oscillation that
-moves the efficiency of the whole run (docs/verification.md, "The start-up transient").
+moves the efficiency of the whole run (docs/verification.md, "The reduced model against its full order").
 """
 
 from __future__ import annotations

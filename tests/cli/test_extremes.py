@@ -1,4 +1,4 @@
-"""Stability at the extremes (issue 8): short scenes at the edges of every knob.  Each run either
+"""Stability at the extremes: short scenes at the edges of every knob.  Each run either
 finishes with finite outputs and an energy that never exceeds what the drive put in, or stops
 with a message naming when and why.  None may hang: each has a wall-clock alarm."""
 
@@ -167,7 +167,7 @@ def test_a_run_whose_energy_budget_the_time_integration_breaks_is_told_so(tmp_pa
 
 
 def test_a_run_whose_bit_rings_is_told_so(tmp_path, alarm):
-    """A 101 m string of 112/90 mm pipe at 39 m/h and 87 rpm (benchmarks/random_scenes_seed7.md, scene 6): from
+    """A 101 m string of 112/90 mm pipe at 39 m/h and 87 rpm (benchmarks/results/random_scenes/random_scenes_seed7.md, scene 6): from
     0.5 s on, the reduced model without its out-of-band damping (reduction.out_of_band_damping = 0, the default
     model before it) has a bit that rings, its angular velocity zig-zagging between 0.1 and 37 rad/s
     from step to step while the full order's moves smoothly (docs/verification.md), and its peak stress at the

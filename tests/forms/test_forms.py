@@ -1,4 +1,4 @@
-"""Energy-derived nonlinear forms (issue 3): linearisation, printed operators, invariances,
+"""Energy-derived nonlinear forms: linearisation, printed operators, invariances,
 positivity, Taylor test of the tangents, and dissipativity of the force laws."""
 
 import basix.ufl
@@ -142,7 +142,7 @@ def test_taylor_second_order_for_the_full_residual(disc):
     for X, b in zip((U, V, A), base):
         X.x.array[:] = b
     rates = np.log2(np.array(remainders[:-1]) / np.array(remainders[1:]))
-    assert rates == pytest.approx(2.0, abs=0.1)  # issue 3: observed rate within 0.1 of 2
+    assert rates == pytest.approx(2.0, abs=0.1)  # observed rate within 0.1 of 2
 
 
 def test_cli_forms_check_passes_and_show_prints(capsys):

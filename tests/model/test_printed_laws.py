@@ -1,4 +1,4 @@
-"""The laws (18), (19), (21) as printed, offered as scene choices (issue 15): each one's sign is the
+"""The laws (18), (19), (21) as printed, offered as scene choices: each one's sign is the
 paper's, so it pushes along the motion, and the energy budget books the work each law does, so that
 a law that injects energy shows up as its own positive term and the balance still closes."""
 

@@ -1,5 +1,5 @@
 """Contact only where it can happen: the wall law is evaluated at the vertices that can reach the wall,
-and the others are left out while a bound on the motion proves they cannot (issue 17)."""
+and the others are left out while a bound on the motion proves they cannot."""
 
 import numpy as np
 import pytest

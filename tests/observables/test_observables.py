@@ -1,4 +1,4 @@
-"""Observables of a run (issue 5): von Mises stress against closed forms, drilling
+"""Observables of a run: von Mises stress against closed forms, drilling
 quantities of synthetic time series with known answers, spectra of sums of sinusoids."""
 
 import numpy as np

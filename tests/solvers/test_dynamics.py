@@ -483,7 +483,7 @@ def test_the_start_up_transient_is_resolved_at_the_default_tolerance(tmp_path):
     """At t = 0 the bit, moving at V0 and Omega, is braked by the rock within microseconds.  Taken at the default
     tolerance, that first step left a torsional oscillation in a lightly damped 15 m string that grew over the run
     (stick-slip severity +46 % at 0.2 s and +70 % at 1 s, the 1 s efficiency -5.7 % in the full order, -1.5 % in
-    the reduced one: docs/verification.md, "The start-up transient").  With the first nominal step at
+    the reduced one: docs/verification.md, "The reduced model against its full order").  With the first nominal step at
     time.start_up_share of the tolerance, the default run must match the run at a hundredth of the tolerance
     everywhere (the reference): rop within 0.05 % and the severity within 5 % (measured: 0.02 % and 1.4 %;
     with time.start_up_share = 1, 0.33 % and 46 %)."""

@@ -1,4 +1,4 @@
-"""Uncertainty quantification (issue 6): the laws of Section 5, and a Monte Carlo study that does
+"""Uncertainty quantification: the laws of Section 5, and a Monte Carlo study that does
 not depend on the number of MPI ranks and survives being killed."""
 
 import json

@@ -1,4 +1,4 @@
-"""Drilling optimisation (issue 7): the grid is made of ordinary runs, the chance constraint is
+"""Drilling optimisation: the grid is made of ordinary runs, the chance constraint is
 its definition, an infeasible window says so, and the robust mode averages its realisations."""
 
 import json

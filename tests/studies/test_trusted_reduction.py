@@ -1,4 +1,4 @@
-"""The default reduced model against closed forms: it never answers silently wrong (issue 14).
+"""The default reduced model against closed forms: it never answers silently wrong.
 
 Strings from 5 to 40 m under their own weight, clamped-pinned (the paper's supports) and pinned-pinned,
 with and without the geometric nonlinearity, in a borehole wide enough that they do not touch it; the
@@ -221,9 +221,9 @@ def bit_motion(length, elements, *extra):
 def test_the_default_reduced_drilling_run_matches_the_full_order_through_the_start_up():
     """A 20 m string on the wall starts drilling: the bit lands on the rock at V0 and the string winds up.
     With the step converged at the bit (time.error_tolerance = 1e-7 m; at the default 1e-5 m neither model
-    resolves the bit's stiff start-up, benchmarks/RESULTS.md), the default reduced model (43 unknowns) and
+    resolves the bit's stiff start-up, docs/performance.md), the default reduced model (43 unknowns) and
     the full order (360) agree: measured 0.03 % on rop, 0.8 % on the RMS of the bit velocity and of the
-    bit spin.  Tolerances: issue 14's targets, 1 % on rop and mean velocity and 10 % on the RMS."""
+    bit spin.  Tolerances: the reduced model's targets, 1 % on rop and mean velocity and 10 % on the RMS."""
     tight = "time.error_tolerance=1e-7"
     reduced = bit_motion(20.0, 40, tight)
     full = bit_motion(20.0, 40, tight, "reduction.rule='none'")
@@ -233,7 +233,7 @@ def test_the_default_reduced_drilling_run_matches_the_full_order_through_the_sta
     assert reduced["spin_rms"] == pytest.approx(full["spin_rms"], rel=0.10)
 
 
-#: A 101 m string of 112/90 mm pipe at 39 m/h and 87 rpm (benchmarks/random_scenes_seed7.md, scene 6), which
+#: A 101 m string of 112/90 mm pipe at 39 m/h and 87 rpm (benchmarks/results/random_scenes/random_scenes_seed7.md, scene 6), which
 #: sticks and slips from 0.5 s on.
 STICKING = ["beam.length=101.068", "beam.elements=253", "beam.outer_radius=0.056008", "beam.inner_radius=0.0450352",
             "borehole.radius=0.0742886", "drive.axial_velocity=0.0109340101", "drive.rotation_speed=9.13149305",
@@ -297,7 +297,7 @@ def test_a_pinned_string_resting_on_the_wall_takes_the_weight_on_bit_as_its_full
     The basis holds the string's responses at rest (its tangent, with the wall's springs) to the bit force and
     the wall's friction (studies/prepare.py, ``reduction.rest_response_tolerance``), so the reduced model's peak
     matches the full order's: measured -0.03 %; without them (tolerance 1) -1.3 %, the error the random pinned
-    scenes showed in their runs (benchmarks/random_scenes_pinned.md).  Tolerance 0.2 %: the response is
+    scenes showed in their runs (benchmarks/results/random_scenes/random_scenes_pinned.md).  Tolerance 0.2 %: the response is
     linearised at rest, and 30 kN moves the touchdown by about an element."""
     from fenics_drill.model.forces.axial_tip_load import AxialTipLoad
     from fenics_drill.solvers.static import solve_static
@@ -321,7 +321,7 @@ def test_a_pinned_string_resting_on_the_wall_takes_the_weight_on_bit_as_its_full
     assert abs(without / full - 1) > 5 * abs(reduced / full - 1)  # what the responses at rest bring
 
 
-#: A 94 m string of 58/44 mm pipe in a 98 mm hole between two stabilisers (benchmarks/random_scenes_stabilisers.md,
+#: A 94 m string of 58/44 mm pipe in a 98 mm hole between two stabilisers (benchmarks/results/random_scenes/random_scenes_stabilisers.md,
 #: scene 1): it rests on the wall from end to end but at the stabilisers, 40 mm above it.
 STABILISED = ["beam.length=94.0786", "beam.elements=235", "beam.outer_radius=0.0578877", "beam.inner_radius=0.0444586",
               "borehole.radius=0.0976337", "drive.axial_velocity=0.00452349006", "drive.rotation_speed=11.3420693",
@@ -334,7 +334,7 @@ def test_a_stabilised_thin_string_rests_on_the_wall_as_its_full_order_does(tmp_p
     and the reduced model damps them as it damps its other directions above 2 f_max (DrillstringModel.resting_at).
     Without that, this string's reduced model lifted off the wall at 0.54 s and bounced (217 impacts by 0.7 s, rop
     +6.4 %) where its full order rests (2 impacts); with it, over 0.7 s: 2 impacts, rop -0.03 %, efficiency -0.05 %
-    (docs/verification.md, "Stabilisers").  Tolerances: 0.5 % on rop and efficiency, a few impacts more than the
+    (docs/verification.md, "The reduced model against its full order").  Tolerances: 0.5 % on rop and efficiency, a few impacts more than the
     full order's (the reduced contact still flickers at a few vertices: its peak stress is 2.9 % low here)."""
     from fenics_drill.studies.run import run_scene
 

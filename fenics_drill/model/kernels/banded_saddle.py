@@ -9,7 +9,7 @@ eliminated exactly instead of bordering the matrix:
     mu = (r_c - (J x)_c) / b
 
 and A is factorised by LAPACK's banded LU (dgbtrf): O(n w^2) for a band of width w, against a general
-sparse LU's fill and bookkeeping (benchmarks/RESULTS.md, issue 17).
+sparse LU's fill and bookkeeping (docs/performance.md).
 """
 
 from __future__ import annotations

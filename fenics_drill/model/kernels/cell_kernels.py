@@ -3,7 +3,7 @@ assembler, and an expression at every cell without DOLFINx's coefficient packing
 
 A sampled internal force (:mod:`fenics_drill.model.reduction.hyper_reduction`) lives on a handful of elements, and
 at every Newton iterate DOLFINx's ``assemble_vector`` spent about ten times longer in its set-up than in
-the kernels of those cells (benchmarks/RESULTS.md, issue 17).  :class:`CellAssembly` calls the form's
+the kernels of those cells (docs/performance.md).  :class:`CellAssembly` calls the form's
 generated ``tabulate_tensor`` directly, cell after cell, and adds each element tensor at its dofs: the
 sampled force, its tangents and its energies.  The kernel is called through its address, so the compiled
 loop is cached on disk like every other kernel.

@@ -28,7 +28,7 @@ axis and stiffen it (the sag of a 30 m string came out 40 % short); the companio
 part of it (677 of 747 mm), and the static state added by
 :func:`fenics_drill.studies.prepare.prepare` all of it.  In the dynamics of the paper scene
 the companions make the bit velocity fluctuate 60 % more than the full order
-(benchmarks/reduced_accuracy.md), so they are off by default.  Every added vector is
+(benchmarks/results/reduced_accuracy.md), so they are off by default.  Every added vector is
 M-orthogonalised against the basis and M-normalised.
 """
 

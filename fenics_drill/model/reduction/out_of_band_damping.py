@@ -9,7 +9,7 @@ spin rate, a negative damping (about -190 N m s/rad); on the full string the tor
 carry that energy away (the pipe's wave impedance rho J c_T is about 220 N m s/rad), but the bit-local Ritz
 direction has no waves, and it rang: the bit's angular velocity zig-zagged from step to step, the peak stress
 at the bit came out 7-11 % high and short strings' stick-slip twice as violent as in their full order
-(docs/verification.md, "Ringing bits: the basis's directions above the band").
+(docs/verification.md, "The reduced model against its full order").
 
 This force gives every Ritz direction above OUT_OF_BAND_FACTOR x f_max the modal damping ratio
 ``reduction.out_of_band_damping`` (0.1 by default): f = -C qd with C = M_r X diag(2 zeta omega) X^T M_r over the
