@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -154,11 +155,17 @@ def cmd_optimize(args) -> int:
 
 def cmd_plot(args) -> int:
     """Figures of a saved run (Figs. 13-23), Monte Carlo study (Figs. 28-35) or operating window (24-27, 36)."""
+    from fenics_drill.io.files import read_json
+    from fenics_drill.io.output_directory import FIGURE_RECORD
     from fenics_drill.plots.directory import plot_directory
 
     directory = Path(args.run_dir)
     paths = plot_directory(directory, gif=not args.no_gif)
     print(f"{len(paths)} files in {directory}: " + ", ".join(p.name for p in paths))
+    banner = read_json(directory / FIGURE_RECORD)["drawn_from"].get("banner")
+    if banner:
+        print(f"note: {banner[len('PARTIAL: '):]}; the figures say so in red, and the next command that writes "
+              f"{directory} removes them")
     return 0
 
 
@@ -270,35 +277,59 @@ def _execute(args) -> int:
     """Run a command in this process; ordinary errors become messages, other errors under MPI end the job."""
     from mpi4py import MPI
 
+    from fenics_drill.io.files import no_room_message
+    from fenics_drill.io.study_directory import RankStopped
+
     comm = MPI.COMM_WORLD
     where = f" (rank {comm.rank} of {comm.size})" if comm.size > 1 else ""
     try:
         return args.func(args)
     except _user_errors() as err:
         kind = "scene error: " if isinstance(err, SceneError) else ""
-        print(f"fenics-drill{where}: {kind}{err}", file=sys.stderr)
+        _say(f"fenics-drill{where}: {kind}{err}")
         if comm.size > 1 and not isinstance(err, _collective_errors()):
-            sys.stderr.flush()
             comm.Abort(2)
         return 2
     except KeyboardInterrupt:
-        print(f"fenics-drill{where}: interrupted", file=sys.stderr)
+        _say(f"fenics-drill{where}: interrupted")
         return 130
-    except Exception:
-        if comm.size == 1:
+    except RankStopped as stop:
+        _say(f"fenics-drill{where}: stopped: {stop}")
+        return 130 if stop.status == "interrupted" else 1
+    except Exception as err:
+        room = no_room_message(err)
+        if room is not None:
+            _say(f"fenics-drill{where}: cannot write to {getattr(args, 'out', 'the output directory')}: {room}")
+        elif comm.size == 1:
             raise
-        import traceback
+        else:
+            import traceback
 
-        traceback.print_exc()
-        print(f"fenics-drill{where}: failed; ending every rank", file=sys.stderr)
-        sys.stderr.flush()
-        comm.Abort(1)
+            traceback.print_exc()
+            _say(f"fenics-drill{where}: failed; ending every rank")
+        if comm.size > 1:
+            comm.Abort(1)
         return 1
+
+
+def _say(line: str) -> None:
+    """One line on stderr, written at once (a rank about to be aborted must not lose it in a buffer)."""
+    sys.stderr.flush()
+    os.write(2, (line + "\n").encode())
 
 
 def main(argv: list[str] | None = None) -> int:
     """The ``fenics-drill`` tool.  Called without ``argv`` (the console script), ``run``, ``static`` and
-    ``modal`` go to a supervised worker process; with ``argv`` (tests, scripts) everything runs here."""
+    ``modal`` go to a supervised worker process; with ``argv`` (tests, scripts) everything runs here.  A Ctrl-C
+    anywhere, even while the libraries load, ends it with one line and exit code 130."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        _say("fenics-drill: interrupted")
+        return 130
+
+
+def _main(argv: list[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if argv is None and args.command in SUPERVISED:

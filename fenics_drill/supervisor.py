@@ -67,20 +67,25 @@ def supervise(argv: list[str], command: str, out: Path | None) -> int:
                     worker.kill()
                     worker.wait()
                     _mark_killed(out, command, received[0], f"the command did not stop within {GRACE_SECONDS:g} s "
-                                 "(it was inside a long computation) and was killed")
+                                 "(it was inside a long computation) and was killed", "interrupted")
                     return 130
     finally:
         for s, handler in previous.items():  # after a signal, the later ones of the same Ctrl-C or kill are ignored
             signal.signal(s, signal.SIG_IGN if received else handler)
     if code < 0:  # the worker died of a signal: one it could not handle (SIGKILL from outside, a crash), or a late
         # second Ctrl-C or SIGTERM after it had written its summary and given the handlers back
-        _mark_killed(out, command, -code, "the command died of it before it wrote its summary")
-        return 130 if received else 128 - code
+        if received:
+            _mark_killed(out, command, -code, "the command died of it before it wrote its summary", "interrupted")
+            return 130
+        _mark_killed(out, command, -code, "nothing here sent it: the out-of-memory killer, a hard limit of a batch "
+                     "system, or a crash", "killed")
+        return 128 - code
     return code
 
 
-def _mark_killed(out: Path | None, command: str, signum: int, how: str) -> None:
-    """Say in ``out/summary.json`` that the command was ended from outside, keeping what it recorded."""
+def _mark_killed(out: Path | None, command: str, signum: int, how: str, status: str) -> None:
+    """Say in ``out/summary.json`` that the command was ended from outside (``status``: interrupted when the user
+    asked it to stop, killed otherwise), keeping what it recorded."""
     if out is None or not out.is_dir():
         return
     path = out / "summary.json"
@@ -91,6 +96,6 @@ def _mark_killed(out: Path | None, command: str, signum: int, how: str) -> None:
     if summary.get("command") != command or summary.get("status") not in (None, "running"):
         return  # not this command's directory, or the worker wrote its own final summary
     name = signal.Signals(signum).name
-    summary.update(status="interrupted",
-                   message=f"ended by {name}: {how}; the files hold everything up to their last write")
+    summary.update(status=status, message=f"ended by {name}: {how}; the files hold everything up to their last write")
+    summary.pop("pid", None)
     write_json(path, summary)

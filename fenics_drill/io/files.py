@@ -93,3 +93,23 @@ class FlushClock:
         """Record a write that took ``duration`` seconds; the next is due after the stretched interval."""
         self.interval = max(self.seconds, duration / self.share)
         self.last = time.monotonic()
+
+
+#: errno of the ways a write finds no room: no space left, quota exceeded, file beyond the size limit.
+_NO_ROOM = {28: "the disk is full (no space left on the device)", 122: "the disk quota is exceeded",
+            27: "a file reached the size limit (ulimit -f)"}
+
+
+def no_room_message(err: BaseException) -> str | None:
+    """A one-line reason if ``err`` (or an error it was raised from) is a write that found no room on the disk;
+    None otherwise.  HDF5's errors carry the errno only in their text."""
+    while err is not None:
+        if isinstance(err, OSError):
+            if err.errno in _NO_ROOM:
+                return _NO_ROOM[err.errno]
+            text = str(err)
+            for code, reason in _NO_ROOM.items():
+                if f"errno = {code}," in text or os.strerror(code) in text:
+                    return reason
+        err = err.__cause__ or err.__context__
+    return None

@@ -9,7 +9,13 @@
 * A directory with files that are not a command's output is never touched.
 * One process at a time: an exclusive lock (``.fenics-drill.lock``, released by the
   kernel when the process dies) refuses a second command on the same directory.
-* While the command works, ``summary.json`` says ``"status": "running"`` with its pid.
+* While the command works, ``summary.json`` says ``"status": "running"`` with its pid and host; a
+  "running" summary whose process is gone (killed, out of memory) reads as ``"killed"``
+  (:func:`summary_of`).
+* A refused command leaves nothing behind: no lock file, no directory it created.
+* Figures drawn from a directory are listed in ``figures.json`` with the state they were drawn from;
+  a command that writes the directory again removes them (:func:`remove_figures`), so no figure
+  passes for current.
 
 Every refusal is an :class:`OutputError` naming the directory and the remedy.
 """
@@ -19,27 +25,31 @@ from __future__ import annotations
 import fcntl
 import os
 import shutil
+import socket
 import time
 from pathlib import Path
 
 from fenics_drill.io.files import UnreadableFile, read_json, write_json
 
 LOCK_NAME = ".fenics-drill.lock"
+#: The list of figures drawn from a directory, and the state they were drawn from.
+FIGURE_RECORD = "figures.json"
 
 #: What each command owns in its directory (glob patterns), and what marks a directory as its own
 #: when an older version wrote no ``command`` into ``summary.json``.
 OWNED = {
     "run": ("summary.json", "timeseries.h5", "fields.xdmf", "fields.h5", "fig*.png", "spectra.json",
-            "animation.gif"),
+            "animation.gif", FIGURE_RECORD),
     "static": ("summary.json", "static.json", "static.xdmf", "static.h5"),
     "modal": ("summary.json", "modes.json"),
-    "mc": ("summary.json", "scene.json", "nominal.h5", "realisations", "statistics.h5", "fig*.png"),
-    "optimize": ("summary.json", "scene.json", "points", "optimize.json", "fig*.png"),
+    "campbell": ("summary.json", "campbell.json", "campbell.png", FIGURE_RECORD),
+    "mc": ("summary.json", "scene.json", "nominal.h5", "realisations", "statistics.h5", "fig*.png", FIGURE_RECORD),
+    "optimize": ("summary.json", "scene.json", "points", "optimize.json", "fig*.png", FIGURE_RECORD),
 }
-SIGNATURE = {"run": "timeseries.h5", "static": "static.json", "modal": "modes.json", "mc": "realisations",
-             "optimize": "points"}
+SIGNATURE = {"run": "timeseries.h5", "static": "static.json", "modal": "modes.json", "campbell": "campbell.json",
+             "mc": "realisations", "optimize": "points"}
 DESCRIPTION = {"run": "a drilling run", "static": "a static equilibrium", "modal": "a modal analysis",
-               "mc": "a Monte Carlo study", "optimize": "an operating-window study"}
+               "campbell": "a Campbell diagram", "mc": "a Monte Carlo study", "optimize": "an operating-window study"}
 
 
 class OutputError(ValueError):
@@ -60,6 +70,50 @@ def directory_kind(out: Path) -> str | None:
         if (out / marker).exists():
             return command
     return None
+
+
+def _process_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def summary_of(out: Path) -> dict | None:
+    """``out/summary.json`` (None if absent), with a "running" status whose process is gone on this host read as
+    "killed": the command was ended before it could say how (SIGKILL, the out-of-memory killer, a full disk)."""
+    path = out / "summary.json"
+    if not path.is_file():
+        return None
+    summary = read_json(path)
+    pid = summary.get("pid")
+    if (summary.get("status") == "running" and isinstance(pid, int) and summary.get("host") == socket.gethostname()
+            and not _process_alive(pid)):
+        summary = {**summary, "status": "killed",
+                   "message": f"the process (pid {pid}) ended without a final summary: it was killed (SIGKILL, out "
+                              "of memory, a full disk, a lost node); the files hold what it wrote before"}
+    return summary
+
+
+def remove_figures(out: Path) -> list[str]:
+    """Remove the figures listed in ``figures.json`` and the list itself: they were drawn from a state of the
+    directory that a command is about to change.  Returns their names."""
+    record = out / FIGURE_RECORD
+    if not record.is_file():
+        return []
+    try:
+        names = read_json(record).get("figures", [])
+    except UnreadableFile:
+        names = []
+    for name in names:
+        path = out / Path(name).name
+        if path.is_file():
+            path.unlink()
+    record.unlink()
+    return names
 
 
 def owned_paths(out: Path, command: str) -> list[Path]:
@@ -123,11 +177,20 @@ def claim_output(out: str | Path, command: str, overwrite: bool = False, resume:
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise OutputError(f"--out {out} is a file, not a directory: choose a directory")
+    if resume and not (out.is_dir() and directory_kind(out) == command):
+        raise OutputError(f"--resume: --out {out} holds no 'fenics-drill {command}' study to continue; drop "
+                          "--resume to start one")
+    created_dir = not out.exists()
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as err:
         raise OutputError(f"cannot create --out {out}: {err.strerror}") from err
-    lock = _lock(out)
+    created_lock = not (out / LOCK_NAME).exists()
+    try:
+        lock = _lock(out)
+    except OutputError:  # in use (the lock is the other process's) or not writable (no lock was made)
+        _leave_nothing(out, created_dir, created_lock=False)
+        raise
     try:
         kind = directory_kind(out)
         if kind is not None and kind != command:
@@ -145,10 +208,25 @@ def claim_output(out: str | Path, command: str, overwrite: bool = False, resume:
                                   f"it{remedy}, or choose another --out")
             for path in owned_paths(out, command):
                 shutil.rmtree(path) if path.is_dir() else path.unlink()
+        remove_figures(out)
         write_json(out / "summary.json", {"command": command, "status": "running", "pid": os.getpid(),
+                                          "host": socket.gethostname(),
                                           "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), **(record or {})})
     except BaseException:
         fcntl.flock(lock, fcntl.LOCK_UN)
         lock.close()
+        _leave_nothing(out, created_dir, created_lock)
         raise
     return OutputClaim(out, command, lock)
+
+
+def _leave_nothing(out: Path, created_dir: bool, created_lock: bool) -> None:
+    """After a refusal: remove the lock file this command created, and the directory if it created it and it is
+    empty, so that a refused command leaves the user's directory as it was."""
+    if created_lock:
+        (out / LOCK_NAME).unlink(missing_ok=True)
+    if created_dir:
+        try:
+            out.rmdir()
+        except OSError:
+            pass

@@ -35,6 +35,7 @@ class TimeSeriesWriter:
         self.path = Path(path)
         self.clock = clock or FlushClock()
         self.buffer: dict[str, list] = {name: [] for name in VARIABLES}
+        self.rows_written = 0  # rows in the file: the initial state and the accepted steps
         write_atomic(self.path, lambda tmp: self._create(tmp, vertex_x, attributes, modes, held_modes))
 
     @staticmethod
@@ -92,6 +93,7 @@ class TimeSeriesWriter:
                 f["impacts_per_vertex"][:] = impacts_per_vertex
 
         update_hdf5(self.path, update)
+        self.rows_written += n
         for values in self.buffer.values():
             del values[:n]
         self.clock.wrote(time.monotonic() - started)

@@ -13,13 +13,15 @@ call returns; :mod:`fenics_drill.supervisor` bounds that wait for the command-li
 from __future__ import annotations
 
 import signal
+import sys
 import threading
 import time
 from contextlib import contextmanager
 from pathlib import Path
 
-from fenics_drill.io.files import write_json
+from fenics_drill.io.files import UnreadableFile, read_json, write_json
 from fenics_drill.io.output_directory import claim_output
+from fenics_drill.io.study_directory import RankStopped, mark_rank
 from fenics_drill.model.resources import check_memory
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -42,7 +44,15 @@ class StopOnSignal:
             for s in SIGNALS:
                 signal.signal(s, self._first)
             self.outer, StopOnSignal.active = StopOnSignal.active, self
+            self.previous_hook, sys.unraisablehook = sys.unraisablehook, self._unraisable
         return self
+
+    def _unraisable(self, unraisable) -> None:
+        """The interrupt raised where Python can only print it (a weakref callback, a destructor, a C library's
+        callback) is not printed: ``requested`` stays set, and the next :func:`uninterrupted` block or study
+        step raises it again."""
+        if not issubclass(unraisable.exc_type, KeyboardInterrupt):
+            self.previous_hook(unraisable)
 
     def _first(self, signum, frame):
         for s in SIGNALS:
@@ -54,8 +64,16 @@ class StopOnSignal:
     def __exit__(self, *exc) -> None:
         if self.previous is not None:
             StopOnSignal.active = self.outer
+            sys.unraisablehook = self.previous_hook
             for s, handler in self.previous.items():
                 signal.signal(s, handler)
+
+
+def stop_if_requested() -> None:
+    """Raise KeyboardInterrupt if a signal arrived and its interrupt was lost (a study checks between tasks)."""
+    stop = StopOnSignal.active
+    if stop is not None and stop.requested and not stop.deferring:
+        raise KeyboardInterrupt
 
 
 @contextmanager
@@ -105,3 +123,55 @@ def command_output(out: str | Path, command: str, scene, overwrite: bool = False
                     write_json(out / "summary.json", summary)
     finally:
         claim.release()
+
+
+@contextmanager
+def study_run(out: Path, command: str, comm, counts):
+    """One rank's part of a study (``mc``, ``optimize``) spread over MPI ranks: signals stop it
+    (:class:`StopOnSignal`), its marker in ``.ranks/`` says how it ended, and ``summary.json`` is final however
+    the study ends: interrupted, or failed with the failing rank's message (rank 0, or the failing rank itself,
+    writes it; ``counts()`` adds what is done).  A rank leaving the block ignores further signals, so that
+    waiting in MPI_Finalize for the others it is not killed by the Ctrl-C they are still handling."""
+    status = message = None
+    try:
+        with StopOnSignal():
+            try:
+                yield
+            except RankStopped as stop:
+                status, message = ("interrupted" if stop.status == "interrupted" else "failed"), str(stop)
+                raise
+            except KeyboardInterrupt:
+                status, message = "interrupted", "stopped by Ctrl-C or SIGTERM"
+                mark_rank(out, comm.rank, status, message)
+                raise
+            except Exception as err:
+                where = f"rank {comm.rank}: " if comm.size > 1 else ""
+                status, message = "failed", f"{where}{err}"
+                mark_rank(out, comm.rank, status, str(err))
+                raise
+            finally:
+                if status is not None:
+                    with uninterrupted(stop_after=False):
+                        _final_study_summary(out, command, status, message, comm.rank == 0 or status == "failed",
+                                             counts)
+    finally:
+        if comm.size > 1:
+            for s in SIGNALS:
+                signal.signal(s, signal.SIG_IGN)
+
+
+def _final_study_summary(out: Path, command: str, status: str, message: str, always: bool, counts) -> None:
+    """The study's summary with its final status, if it is still "running" (or ``always``)."""
+    try:
+        summary = read_json(out / "summary.json")
+    except (UnreadableFile, OSError):
+        summary = {"command": command}
+    if summary.get("status") != "running" and not always:
+        return
+    try:
+        done = counts()
+    except Exception:  # the directory may be unreadable (a full disk): the status still goes in
+        done = {}
+    summary.update(status=status, message=message, **done)
+    summary.pop("pid", None)
+    write_json(out / "summary.json", summary)

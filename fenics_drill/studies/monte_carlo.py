@@ -21,8 +21,9 @@ from mpi4py import MPI
 
 from fenics_drill.io.files import UnreadableFile, usable_result
 from fenics_drill.io.realisations import NOMINAL, read_realisation, realisation_path, write_realisation
-from fenics_drill.io.study_directory import all_done, claim
+from fenics_drill.io.study_directory import all_done, claim, polled_barrier, stopped_rank
 from fenics_drill.model.resources import check_memory
+from fenics_drill.studies.lifecycle import stop_if_requested, study_run
 from fenics_drill.studies.prepare import prepare, run_realisation
 from fenics_drill.studies.statistics import write_statistics
 from fenics_drill.studies.uncertainty import BitRockLaws
@@ -50,21 +51,28 @@ def monte_carlo(scene, samples: int, out: str | Path, resume: bool = False, prog
     out = Path(out)
     laws = BitRockLaws(scene.bit_rock, scene.uncertainty)  # refuses inadmissible laws
     check_memory(scene.beam.elements, scene.beam.element_degree)
-    with claim(out, scene.to_dict(), "mc", resume, overwrite, comm):
-        (out / "realisations").mkdir(exist_ok=True)
-        comm.Barrier()
+    def counts() -> dict:
+        return {"samples": samples, "realisations_done": len(list((out / "realisations").glob("*.h5")))}
+
+    with claim(out, scene.to_dict(), "mc", resume, overwrite, comm), study_run(out, "mc", comm, counts):
+        if comm.rank == 0:
+            (out / "realisations").mkdir(exist_ok=True)
+        polled_barrier(comm)
         prepared = prepare(scene)
         if comm.rank == 0 and not usable_result(out / NOMINAL, read_realisation):
             write_realisation(out / NOMINAL, run_realisation(prepared, scene))
         done_at_start = len(list((out / "realisations").glob("*.h5")))
         started = time.perf_counter()
         for k in range(comm.rank, samples, comm.size):
+            stop_if_requested()
+            if (stop := stopped_rank(out, comm.rank)) is not None:
+                raise stop
             path = realisation_path(out, k)
             if usable_result(path, read_realisation):
                 continue
             write_realisation(path, run_realisation(prepared, scene.with_changes(bit_rock=laws.sample(k))))
             if progress and comm.rank == 0:
                 _progress(out, samples, started, done_at_start)
-        if not all_done(comm, progress):
+        if not all_done(out, comm, progress):
             return None
         return write_statistics(out, samples)

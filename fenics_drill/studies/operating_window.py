@@ -33,8 +33,9 @@ from mpi4py import MPI
 from scipy import interpolate, optimize
 
 from fenics_drill.io.files import read_json, usable_result, write_json
-from fenics_drill.io.study_directory import all_done, claim
+from fenics_drill.io.study_directory import all_done, claim, polled_barrier, stopped_rank
 from fenics_drill.model.resources import check_memory
+from fenics_drill.studies.lifecycle import stop_if_requested, study_run
 from fenics_drill.studies.prepare import prepare, run_realisation
 from fenics_drill.studies.uncertainty import BitRockLaws
 
@@ -162,15 +163,22 @@ def run_optimize(scene, out: str | Path, resume: bool = False, progress: bool = 
     v0, omega = grid_axis(opt.axial_velocity), grid_axis(opt.rotation_speed)
     total = len(v0) * len(omega) * max(opt.samples, 1)
     check_memory(scene.beam.elements, scene.beam.element_degree)
-    with claim(out, scene.to_dict(), "optimize", resume, overwrite, comm):
-        (out / "points").mkdir(exist_ok=True)
-        comm.Barrier()
+    def counts() -> dict:
+        return {"runs": total, "runs_done": len(list((out / "points").glob("*.json")))}
+
+    with claim(out, scene.to_dict(), "optimize", resume, overwrite, comm), study_run(out, "optimize", comm, counts):
+        if comm.rank == 0:
+            (out / "points").mkdir(exist_ok=True)
+        polled_barrier(comm)
         prepared = prepare(scene)
         started = time.perf_counter()
         for n, point, i, j, draw in _tasks(len(v0), len(omega), opt.samples):
             path = _task_path(out, point, draw)
             if n % comm.size != comm.rank or usable_result(path, read_json):
                 continue
+            stop_if_requested()
+            if (stop := stopped_rank(out, comm.rank)) is not None:
+                raise stop
             bit_rock = dataclasses.asdict(scene.bit_rock) if draw == NOMINAL_DRAW else laws.sample(draw)
             result = _evaluate(prepared, scene, v0[i], omega[j], bit_rock)
             write_json(path, result)
@@ -178,6 +186,6 @@ def run_optimize(scene, out: str | Path, resume: bool = False, progress: bool = 
                 done = len(list((out / "points").glob("*.json")))
                 sys.stderr.write(f"\r  runs {done:5d} / {total}  wall {time.perf_counter() - started:8.1f} s ")
                 sys.stderr.flush()
-        if not all_done(comm, progress):
+        if not all_done(out, comm, progress):
             return None
         return assemble(scene, out)

@@ -27,6 +27,7 @@ from fenics_drill.observables.step_rows import StepRows
 from fenics_drill.solvers.static import StaticEquilibrium, StaticFailure, solve_static, static_report
 from fenics_drill.solvers.step_control import StepTooSmall
 from fenics_drill.solvers.time_loop import Simulation
+from fenics_drill.studies.lifecycle import uninterrupted
 
 #: Time histories kept per realisation (Figs. 29, 31, 33).
 HISTORIES = ("bit_displacement", "bit_velocity", "bit_rotation", "bit_angular_velocity", "section_w",
@@ -218,7 +219,7 @@ def run_realisation(prepared: PreparedScene, scene) -> dict:
     clock = time.perf_counter()
     status, message = "finished", "reached time.t_end"
     try:
-        simulation.run(start, scene.time.t_end, recorder)
+        simulation.run(start, scene.time.t_end, recorder, atomic=uninterrupted)  # a signal stops it between steps
     except StepTooSmall as failure:
         status, message = "failed", str(failure)
     series = {k: np.asarray(v, dtype=float) for k, v in recorder.series.items()}

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import socket
 import sys
 import time
 from pathlib import Path
@@ -17,8 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from fenics_drill.io.fields import FieldWriter
-from fenics_drill.io.files import write_json
-from fenics_drill.io.output_directory import claim_output
+from fenics_drill.io.files import no_room_message, write_json
+from fenics_drill.io.output_directory import claim_output, remove_figures
 from fenics_drill.io.timeseries import TimeSeriesWriter, read_series
 from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.model.reduction.modes import drive_held_modes
@@ -178,10 +179,13 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
     clock = time.perf_counter()
     summary: dict = {"command": "run", "status": "failed", "message": "", "t_end": 0.0, "steps": 0}
     recorder = simulation = None
+    host = socket.gethostname()
 
     def running(t: float) -> None:
-        write_json(out / "summary.json", {**summary, "status": "running", "pid": os.getpid(), "t_end": t,
-                                          "steps": simulation.stats["steps"],
+        # what the files hold: the rows written are the initial state and the steps taken to t
+        rows = recorder.series.rows_written
+        write_json(out / "summary.json", {**summary, "status": "running", "pid": os.getpid(), "host": host,
+                                          "t_end": t, "steps": max(rows - 1, 0), "rows": rows,
                                           "wall_time_s": time.perf_counter() - clock})
 
     with StopOnSignal():
@@ -212,22 +216,68 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
                 summary.update(_dynamics_summary(model, simulation, recorder, recorder.last_state, u0))
         except StaticFailure as failure:
             summary["message"] = f"at t = 0 s: {failure}"
+        except Exception as err:
+            reached = recorder.last_state.t if recorder is not None and recorder.last_state is not None else 0.0
+            room = no_room_message(err)
+            summary["status"] = "failed"
+            summary["message"] = (f"at t = {reached:.6g} s: cannot write the run's files: {room}" if room else
+                                  f"at t = {reached:.6g} s: {type(err).__name__}: {err}")
+            raise
         finally:
             with uninterrupted(stop_after=False):  # the summary is written whatever comes
-                if recorder is not None:
-                    recorder.close(simulation.impacts_per_vertex)
-                    summary.update(quantities_of_run(out / "timeseries.h5"))
-                if simulation is not None and simulation.model.hyper_reduction is not None:
-                    stats = simulation.stats
-                    summary["hyper_reduction"] = {**simulation.model.hyper_reduction,
-                                                  "checks": stats["sampling_checks"],
-                                                  "max_error_found": stats["max_sampling_error"]}
-                if simulation is not None:
-                    _judge_admissibility(summary, simulation, scene)
-                    _advise_on_energy_budget(summary, scene)
+                _close_run(summary, out, recorder, simulation, scene)
                 summary["wall_time_s"] = time.perf_counter() - clock
-                write_json(out / "summary.json", summary)
+                _write_final_summary(out, summary)
+                remove_figures(out)
                 claim.release()
+    return summary
+
+
+def _close_run(summary: dict, out: Path, recorder, simulation, scene) -> None:
+    """The last rows written and the summary completed from the files.  A disk that is full now fails the run
+    with that reason, but what the files already hold is still summarised."""
+    if recorder is not None:
+        try:
+            recorder.close(simulation.impacts_per_vertex)
+        except OSError as err:
+            room = no_room_message(err)
+            if room is None:
+                raise
+            reached = "reached time.t_end, but " if summary["status"] == "finished" else ""
+            summary["status"] = "failed"
+            summary["message"] = f"{reached}the last rows of timeseries.h5 could not be written: {room}"
+        quantities = quantities_of_run(out / "timeseries.h5")
+        if summary["status"] == "failed":  # a run that failed is no answer: what it did is kept apart
+            summary["until_failure"] = quantities
+        else:
+            summary.update(quantities)
+    if simulation is not None and simulation.model.hyper_reduction is not None:
+        stats = simulation.stats
+        summary["hyper_reduction"] = {**simulation.model.hyper_reduction, "checks": stats["sampling_checks"],
+                                      "max_error_found": stats["max_sampling_error"]}
+    if simulation is not None:
+        _judge_admissibility(summary, simulation, scene)
+        _advise_on_energy_budget(summary, scene)
+
+
+def _write_final_summary(out: Path, summary: dict) -> None:
+    """``summary.json`` with the final status; on a full disk, the status and message alone (a few bytes more
+    may still fit), and if even that fails, the reason on stderr."""
+    try:
+        write_json(out / "summary.json", summary)
+        return
+    except OSError as err:
+        room = no_room_message(err)
+        if room is None:
+            raise
+        if summary["status"] != "failed":
+            summary["status"], summary["message"] = "failed", f"summary.json could not be written: {room}"
+    try:
+        write_json(out / "summary.json", {key: summary.get(key) for key in ("command", "status", "message",
+                                                                           "t_end", "steps")})
+    except OSError:
+        sys.stderr.write(f"fenics-drill: {out / 'summary.json'} could not be written ({summary['message']})\n")
+
     return summary
 
 
