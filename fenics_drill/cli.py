@@ -73,6 +73,8 @@ def cmd_static(args) -> int:
         f"max sag {report['max_sag'] * 1e3:.3f} mm at x = {report['max_sag_position']:.1f} m, "
         f"{len(report['contact_vertices'])} vertices on the wall -> {Path(args.out) / 'static.json'}"
     )
+    for reason in report.get("suspect_reasons", []):
+        print(f"suspect: {reason}")
     return 0
 
 
@@ -256,12 +258,12 @@ def _user_errors() -> tuple[type, ...]:
     from fenics_drill.model.resources import ResourceError
     from fenics_drill.model.reduction.spaces import BasisError
     from fenics_drill.plots.directory import NothingToPlot
-    from fenics_drill.model.rotating_modes import Divergence
+    from fenics_drill.model.rotating_modes import Divergence, TooFewModes
     from fenics_drill.studies.campbell import CampbellError
     from fenics_drill.studies.uncertainty import InadmissibleLaw
 
     return (SceneError, OutputError, ResourceError, UnreadableFile, InadmissibleLaw, NothingToPlot, BasisError,
-            CampbellError, Divergence)
+            CampbellError, Divergence, TooFewModes)
 
 
 def _collective_errors() -> tuple[type, ...]:
@@ -300,6 +302,9 @@ def _execute(args) -> int:
         room = no_room_message(err)
         if room is not None:
             _say(f"fenics-drill{where}: cannot write to {getattr(args, 'out', 'the output directory')}: {room}")
+            if comm.size == 1:  # HDF5 would close the files it could not extend once more at exit, and crash
+                sys.stdout.flush()
+                os._exit(1)
         elif comm.size == 1:
             raise
         else:
@@ -313,9 +318,9 @@ def _execute(args) -> int:
 
 
 def _say(line: str) -> None:
-    """One line on stderr, written at once (a rank about to be aborted must not lose it in a buffer)."""
+    """One line on stderr, flushed at once (a rank about to be aborted must not lose it in a buffer)."""
+    sys.stderr.write(line + "\n")
     sys.stderr.flush()
-    os.write(2, (line + "\n").encode())
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -329,7 +334,24 @@ def main(argv: list[str] | None = None) -> int:
         return 130
 
 
+def _quiet_about_full_disks(unraisable, default=sys.unraisablehook) -> None:
+    """HDF5 objects that could not be closed on a full disk complain again as they are collected (h5py reports
+    them through both hooks); the command says once why it failed."""
+    from fenics_drill.io.files import no_room_message
+
+    if no_room_message(unraisable.exc_value) is None:
+        default(unraisable)
+
+
+def _quiet_excepthook(kind, value, trace, default=sys.excepthook) -> None:
+    from fenics_drill.io.files import no_room_message
+
+    if no_room_message(value) is None:
+        default(kind, value, trace)
+
+
 def _main(argv: list[str] | None) -> int:
+    sys.unraisablehook, sys.excepthook = _quiet_about_full_disks, _quiet_excepthook
     parser = build_parser()
     args = parser.parse_args(argv)
     if argv is None and args.command in SUPERVISED:

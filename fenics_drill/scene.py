@@ -16,12 +16,22 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+import stat
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, get_type_hints
 
 from fenics_drill.forms import BeamProperties
+
+
+#: The longest string a scene may describe [m] (the longest wells drilled are about 15 km).
+MAX_LENGTH = 20_000.0
+#: Most points of the common time grid of a Monte Carlo study's histories (uncertainty.output_interval): each
+#: realisation holds a few histories on it, so 1e6 points are some 50 MB a realisation.
+MAX_GRID_POINTS = 1_000_000
+#: Largest scene file read [bytes]: a scene is a few kB of TOML.
+MAX_SCENE_BYTES = 10_000_000
 
 
 class SceneError(ValueError):
@@ -69,14 +79,16 @@ def _band_or_count(doc: str):
 
 @dataclass(frozen=True)
 class Beam:
-    length: float = _pos("beam length L [m]", 100.0)
-    elements: int = key(250, "number of finite elements [-]", lambda n: n >= 1, ">= 1")
+    length: float = key(100.0, "beam length L [m]", lambda x: 0 < x <= MAX_LENGTH, f"in (0, {MAX_LENGTH:g}]")
+    elements: int = key(250, "number of finite elements [-]", lambda n: n >= 2, ">= 2")
     element_degree: int = key(2, "polynomial degree of u, v, w; the rotations use one degree less [-]",
                               lambda k: 2 <= k <= 5, "an integer in [2, 5]")
     outer_radius: float = _pos("outer radius R_ext [m]", 80e-3)
     inner_radius: float = _nonneg("inner radius R_int [m]", 50e-3)
-    density: float = _pos("mass density rho [kg/m^3]", 7900.0)
-    young_modulus: float = _pos("elastic modulus E [Pa]", 203e9)
+    density: float = key(7900.0, "mass density rho [kg/m^3]", lambda x: 500 <= x <= 25000, "in [500, 25000] (any "
+                         "engineering solid)")
+    young_modulus: float = key(203e9, "elastic modulus E [Pa]", lambda x: 1e9 <= x <= 1e12, "in [1e9, 1e12] (any "
+                               "engineering solid)")
     poisson_ratio: float = key(0.3, "Poisson ratio nu [-]", lambda x: -1.0 < x < 0.5, "in (-1, 0.5)")
     shear_factor: float = key(6.0 / 7.0, "shear factor kappa_s [-]", lambda x: 0 < x <= 1, "in (0, 1]")
     damping: float = _nonneg("viscous damping constant c of Eq. (38) [1/s]", 0.01)
@@ -144,9 +156,10 @@ class Drive:
 
 @dataclass(frozen=True)
 class Time:
-    t_end: float = _pos("end of the simulated interval [s]", 10.0)
+    t_end: float = key(10.0, "end of the simulated interval [s]", lambda x: 1e-6 <= x <= 1e6, "in [1e-6, 1e6]")
     dt: float = key(-1.0, "nominal time step; -1: 1/(time.band_steps f_max), f_max = f*_max c_L / L [s]",
-                    lambda x: x == -1.0 or x > 0, "> 0 (or -1 for the nominal step of time.band_steps)")
+                    lambda x: x == -1.0 or 1e-9 <= x <= 10.0, "in [1e-9, 10] (or -1 for the nominal step of "
+                    "time.band_steps)")
     band_steps: float = key(8.0, "steps per period of f_max in the nominal step (2: the paper's 1/(2 f_max)) [-]",
                             lambda x: x >= 2.0, ">= 2 (Nyquist)")
     newmark_alpha: float = key(0.015, "alpha of Newmark's gamma = 1/2 + alpha, beta = (1/2 + gamma)^2 / 4 "
@@ -205,7 +218,9 @@ class Supports:
 
 @dataclass(frozen=True)
 class Modal:
-    f_star_max: float = _pos("upper end of the dimensionless band of analysis B = [0, f*_max], Eq. (95) [-]", 4.0)
+    f_star_max: float = key(4.0, "upper end of the dimensionless band of analysis B = [0, f*_max], Eq. (95) [-]",
+                            lambda x: 1.0 <= x <= 64.0, "in [1, 64] (the band holds the first axial and torsional "
+                            "modes, near f* = 0.3-0.5)")
 
 
 @dataclass(frozen=True)
@@ -391,15 +406,15 @@ def _check_relations(scene: Scene) -> Scene:
     if hole.radius <= beam.outer_radius:
         raise SceneError(f"borehole.radius = {hole.radius!r} is not admissible: must be > beam.outer_radius = "
                          f"{beam.outer_radius!r} (the string must fit in the hole)")
+    if beam.length < 10.0 * beam.outer_radius:
+        raise SceneError(f"beam.length = {beam.length!r} is not admissible: must be >= 10 beam.outer_radius = "
+                         f"{10.0 * beam.outer_radius:g} m (a beam model needs a slender string)")
     if scene.output.section == -1.0:
         scene = dataclasses.replace(scene, output=dataclasses.replace(scene.output, section=0.5 * beam.length))
     if scene.output.section > beam.length:
         raise SceneError(f"output.section = {scene.output.section!r} is not admissible: "
                          f"must be in [0, beam.length = {beam.length!r}]")
-    for x in scene.supports.stabilisers:
-        if not 0 < x < beam.length:
-            raise SceneError(f"supports.stabilisers = {list(scene.supports.stabilisers)!r} is not admissible: "
-                             f"every position must be in (0, beam.length = {beam.length!r})")
+    _check_stabilisers(scene)
     if scene.model.contact and scene.contact.stiffness_linear == 0:
         raise SceneError("contact.stiffness_linear = 0.0 is not admissible with model.contact = true: without "
                          "its linear spring the wall lets the string through (k_FS2 delta^3 is negligible at small "
@@ -427,6 +442,38 @@ def _check_relations(scene: Scene) -> Scene:
                 raise SceneError(f"reduction.{family} = {value!r} is not admissible: "
                                  "reduction.rule = 'count' needs a whole number of modes")
     return scene
+
+
+def check_history_grid(scene: Scene) -> None:
+    """For the studies that keep histories on the grid of uncertainty.output_interval (``mc``, ``optimize``): a
+    grid of at most MAX_GRID_POINTS points, refused before anything is allocated."""
+    grid = scene.time.t_end / scene.uncertainty.output_interval
+    if grid > MAX_GRID_POINTS:
+        raise SceneError(f"uncertainty.output_interval = {scene.uncertainty.output_interval!r} is not admissible with "
+                         f"time.t_end = {scene.time.t_end!r}: the histories' grid would have {grid:.3g} points (at "
+                         f"most {MAX_GRID_POINTS:g}); use an interval >= {scene.time.t_end / MAX_GRID_POINTS:.3g} s")
+
+
+def _check_stabilisers(scene: Scene) -> None:
+    """Each stabiliser inside the string, on a vertex of its own that no end support holds (a stabiliser holds the
+    vertex nearest its position: one that snaps onto a held end, or onto another's vertex, would do nothing)."""
+    beam, positions = scene.beam, list(scene.supports.stabilisers)
+    h = beam.length / beam.elements
+    taken = {}
+    for x in positions:
+        if not 0 < x < beam.length:
+            raise SceneError(f"supports.stabilisers = {positions!r} is not admissible: every position must be in "
+                             f"(0, beam.length = {beam.length!r})")
+        vertex = round(x / h)
+        if vertex in (0, beam.elements):
+            raise SceneError(f"supports.stabilisers: x = {x!r} m is not admissible: it snaps onto the end vertex at "
+                             f"x = {vertex * h:g} m, which the supports hold already; place it at least h/2 = "
+                             f"{h / 2:g} m from the ends, or refine beam.elements")
+        if vertex in taken:
+            raise SceneError(f"supports.stabilisers: x = {taken[vertex]!r} m and x = {x!r} m are not admissible "
+                             f"together: both snap onto the vertex at x = {vertex * h:g} m; refine beam.elements "
+                             "or drop one")
+        taken[vertex] = x
 
 
 def validate(raw: dict[str, Any]) -> Scene:
@@ -470,7 +517,18 @@ def _read_toml(path: Path) -> dict[str, Any]:
     if not path.exists():
         raise SceneError(f"scene file {name} does not exist")
     try:
-        text = path.read_bytes().decode("utf-8")
+        if not stat.S_ISREG(path.stat().st_mode):
+            raise SceneError(f"scene file {name} is not a regular file (a device, a pipe or a socket); a scene is a "
+                             "TOML file")
+        with open(path, "rb") as f:
+            data = f.read(MAX_SCENE_BYTES + 1)
+        if len(data) > MAX_SCENE_BYTES:
+            raise SceneError(f"scene file {name} is larger than {MAX_SCENE_BYTES / 1e6:g} MB: a scene is a few kB of "
+                             "TOML")
+        if not data.strip():
+            raise SceneError(f"scene file {name} is empty; give the keys to change, or leave SCENE out to run the "
+                             "paper's nominal scene")
+        text = data.decode("utf-8")
     except OSError as err:
         raise SceneError(f"scene file {name} cannot be read: {err.strerror}") from err
     except UnicodeDecodeError as err:

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import PAPER
+from conftest import PAPER, expected_status
 
 import fenics_drill as fd
 
@@ -39,7 +39,7 @@ def test_run_returns_its_summary_and_its_time_series_as_xarray(tmp_path):
     assert scene.drive.rotation_speed == 3.0 and scene.beam.length == 10.0
     run = fd.run(scene, out=tmp_path)
     series = run.series
-    assert run.summary["status"] == "finished"
+    assert run.summary["status"] == expected_status(scene)
     assert series["bit_displacement"].attrs["units"] == "m"
     # the drive holds u(0) = V0 t and the string is stiff axially: the bit follows at V0 on average
     travel = float(series["bit_displacement"][-1] - series["bit_displacement"][0])

@@ -49,6 +49,7 @@ MODEL_PARTS = {
     "fenics_drill.model.kernels": 0,
     "fenics_drill.model.discretization": 1,
     "fenics_drill.model.resources": 1,
+    "fenics_drill.model.resolution": 1,
     "fenics_drill.model.operators": 1,
     "fenics_drill.model.internal_force": 1,
     "fenics_drill.model.forces": 1,

@@ -33,12 +33,12 @@ def test_overrides_are_toml_values():
 @pytest.mark.parametrize(
     "override, words",
     [
-        ("beam.length=-1", ["beam.length", "-1", "> 0"]),
+        ("beam.length=-1", ["beam.length", "-1", "(0, 20000]"]),
         ("beam.length=abc", ["beam.length", "abc", "number"]),
         ("beam.inner_radius=0.09", ["beam.inner_radius", "0.09", "beam.outer_radius"]),
         ("borehole.radius=0.07", ["borehole.radius", "0.07", "beam.outer_radius"]),
         ("beam.poisson_ratio=0.5", ["beam.poisson_ratio", "0.5", "(-1, 0.5)"]),
-        ("beam.elements=0", ["beam.elements", "0", ">= 1"]),
+        ("beam.elements=0", ["beam.elements", "0", ">= 2"]),
         ("beam.elements=2.5", ["beam.elements", "2.5", "integer"]),
         ("beam.colour=3", ["beam.colour", "unknown key"]),
         ("cheese.length=3", ["cheese", "unknown section"]),

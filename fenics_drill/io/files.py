@@ -103,13 +103,34 @@ _NO_ROOM = {28: "the disk is full (no space left on the device)", 122: "the disk
 def no_room_message(err: BaseException) -> str | None:
     """A one-line reason if ``err`` (or an error it was raised from) is a write that found no room on the disk;
     None otherwise.  HDF5's errors carry the errno only in their text."""
-    while err is not None:
-        if isinstance(err, OSError):
-            if err.errno in _NO_ROOM:
-                return _NO_ROOM[err.errno]
+    seen = set()
+    while err is not None and id(err) not in seen:
+        seen.add(id(err))
+        if isinstance(err, OSError) and err.errno in _NO_ROOM:
+            return _NO_ROOM[err.errno]
+        if isinstance(err, (OSError, RuntimeError)):  # h5py raises RuntimeError when HDF5 cannot close a file
             text = str(err)
             for code, reason in _NO_ROOM.items():
                 if f"errno = {code}," in text or os.strerror(code) in text:
                     return reason
         err = err.__cause__ or err.__context__
     return None
+
+
+def write_final_json(path: Path, data: dict, keep: tuple[str, ...] = ("command", "status", "message")) -> bool:
+    """Write a command's final ``summary.json`` whatever the disk: atomically if there is room, else the ``keep``
+    keys alone written over the old file in place (truncating it frees its blocks, so a few bytes fit where a
+    second file does not).  False if even that failed."""
+    try:
+        write_json(path, data)
+        return True
+    except Exception as err:
+        if no_room_message(err) is None:
+            raise
+    try:
+        with open(path, "r+" if Path(path).exists() else "w") as f:
+            f.truncate(0)
+            f.write(json.dumps({key: data.get(key) for key in keep}, default=float))
+        return True
+    except OSError:
+        return False

@@ -28,7 +28,7 @@ from fenics_drill.model.discretization import THETA_X, U, V, W, BeamDiscretizati
 from fenics_drill.model.forces import ForceEvaluation, build_forces
 from fenics_drill.model.reduction.hyper_reduction import RETRAIN_ABOVE, sampling_error, train_sample
 from fenics_drill.model.internal_force import ElementSample, internal_force
-from fenics_drill.model.reduction.modes import band_frequency
+from fenics_drill.model.resolution import band_frequency
 from fenics_drill.model.operators import LinearOperators, assemble_linear
 from fenics_drill.model.reduction.out_of_band_damping import OutOfBandDamping
 from fenics_drill.model.reduction.enrichment import augment

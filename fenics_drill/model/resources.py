@@ -59,3 +59,17 @@ def check_memory(elements: int, element_degree: int) -> None:
         raise ResourceError(f"beam.elements = {elements} (degree {element_degree}) needs about {need / 1e9:.1f} GB, "
                             f"more than the {available / 1e9:.1f} GB this machine has available: at most "
                             f"beam.elements = {fits} fits")
+
+
+def check_disk(directory, need_bytes: float, what: str) -> None:
+    """Refuse, before computing, an output that cannot fit in the free space of ``directory``'s file system
+    (``what`` says which file and from which keys its size follows)."""
+    import shutil
+
+    probe = os.path.abspath(directory)
+    while not os.path.exists(probe):
+        probe = os.path.dirname(probe)
+    free = shutil.disk_usage(probe).free
+    if need_bytes > free:
+        raise ResourceError(f"{what}: at least {need_bytes / 1e9:.3g} GB, needed, more than the {free / 1e9:.3g} GB free "
+                            f"where {directory} is: free space, choose another --out, or shorten the run")

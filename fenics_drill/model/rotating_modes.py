@@ -50,6 +50,10 @@ class Divergence(ValueError):
     """A linearised string with negative stiffness: buckled under its axial load (a real eigenvalue > 0)."""
 
 
+class TooFewModes(ValueError):
+    """The eigensolver found fewer whirl modes than asked for: too few dofs, or modes it could not converge."""
+
+
 def held_space(disc: BeamDiscretization, held: tuple = DRIVE) -> FullSpace:
     """The full space without the support and stabiliser dofs and the ``held`` (field, end) pairs."""
     held_dofs = [disc.end_dof(field, end) for field, end in held]
@@ -209,7 +213,9 @@ def solve_whirl_modes(disc: BeamDiscretization, linearisation: SpinLinearisation
         raise Divergence(f"the linearised string diverges (a real eigenvalue {max(growth):.3g} 1/s at {spin:g} rad/s): "
                          "its stiffness is not positive, it is buckled under the axial load")
     if len(values) < n_modes:
-        raise RuntimeError(f"SLEPc's PEP found {len(values)} of the {n_modes} modes asked for at {spin:g} rad/s")
+        raise TooFewModes(f"the spinning string gave {len(values)} of the {n_modes} whirl modes asked for "
+                          f"(campbell.modes) at {spin:g} rad/s: a mesh of {disc.elements} elements may hold too "
+                          "few of them; lower campbell.modes or raise beam.elements")
     order = np.argsort([lam.imag for lam in values])[:n_modes]
     lams = np.array([values[i] for i in order])
     X = np.stack([vectors[i] for i in order], axis=1)

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fenics_drill.model.reduction.modes import band_frequency
+from fenics_drill.model.resolution import band_frequency
 from fenics_drill.model.reduction.spaces import column_bound, stack_rows
 
 

@@ -19,7 +19,7 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
-from fenics_drill.io.files import UnreadableFile, read_json, write_json
+from fenics_drill.io.files import UnreadableFile, no_room_message, read_json, write_final_json, write_json
 from fenics_drill.io.output_directory import claim_output
 from fenics_drill.io.study_directory import RankStopped, mark_rank
 from fenics_drill.model.resources import check_memory
@@ -115,12 +115,13 @@ def command_output(out: str | Path, command: str, scene, overwrite: bool = False
                 summary.update(status="interrupted", message="stopped by Ctrl-C or SIGTERM")
                 raise
             except Exception as err:
-                summary.update(status="failed", message=str(err))
+                room = no_room_message(err)
+                summary.update(status="failed", message=f"cannot write the files: {room}" if room else str(err))
                 raise
             finally:
                 with uninterrupted(stop_after=False):  # the summary is written whatever comes
                     summary["wall_time_s"] = time.perf_counter() - start
-                    write_json(out / "summary.json", summary)
+                    write_final_json(out / "summary.json", summary)
     finally:
         claim.release()
 
@@ -146,8 +147,12 @@ def study_run(out: Path, command: str, comm, counts):
                 raise
             except Exception as err:
                 where = f"rank {comm.rank}: " if comm.size > 1 else ""
-                status, message = "failed", f"{where}{err}"
-                mark_rank(out, comm.rank, status, str(err))
+                reason = no_room_message(err) or f"{type(err).__name__}: {err}"
+                status, message = "failed", f"{where}{reason}"
+                try:
+                    mark_rank(out, comm.rank, status, reason)
+                except OSError:
+                    pass  # a full disk: the summary below may still fit
                 raise
             finally:
                 if status is not None:
@@ -174,4 +179,4 @@ def _final_study_summary(out: Path, command: str, status: str, message: str, alw
         done = {}
     summary.update(status=status, message=message, **done)
     summary.pop("pid", None)
-    write_json(out / "summary.json", summary)
+    write_final_json(out / "summary.json", summary)

@@ -23,6 +23,7 @@ from fenics_drill.io.files import UnreadableFile, usable_result
 from fenics_drill.io.realisations import NOMINAL, read_realisation, realisation_path, write_realisation
 from fenics_drill.io.study_directory import all_done, claim, polled_barrier, stopped_rank
 from fenics_drill.model.resources import check_memory
+from fenics_drill.scene import check_history_grid
 from fenics_drill.studies.lifecycle import stop_if_requested, study_run
 from fenics_drill.studies.prepare import prepare, run_realisation
 from fenics_drill.studies.statistics import write_statistics
@@ -50,6 +51,7 @@ def monte_carlo(scene, samples: int, out: str | Path, resume: bool = False, prog
     """Run (or finish) the study; rank 0 returns the summary, the other ranks None."""
     out = Path(out)
     laws = BitRockLaws(scene.bit_rock, scene.uncertainty)  # refuses inadmissible laws
+    check_history_grid(scene)
     check_memory(scene.beam.elements, scene.beam.element_degree)
     def counts() -> dict:
         return {"samples": samples, "realisations_done": len(list((out / "realisations").glob("*.h5")))}

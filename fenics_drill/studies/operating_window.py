@@ -35,6 +35,7 @@ from scipy import interpolate, optimize
 from fenics_drill.io.files import read_json, usable_result, write_json
 from fenics_drill.io.study_directory import all_done, claim, polled_barrier, stopped_rank
 from fenics_drill.model.resources import check_memory
+from fenics_drill.scene import check_history_grid
 from fenics_drill.studies.lifecycle import stop_if_requested, study_run
 from fenics_drill.studies.prepare import prepare, run_realisation
 from fenics_drill.studies.uncertainty import BitRockLaws
@@ -92,6 +93,7 @@ def assemble(scene, out: Path) -> dict:
     """Read every point's results and write DIR/optimize.json: grids, maps, admissible mask, optimum."""
     opt = scene.optimize
     v0, omega = grid_axis(opt.axial_velocity), grid_axis(opt.rotation_speed)
+    check_history_grid(scene)
     draws = [NOMINAL_DRAW] if opt.samples == 0 else list(range(opt.samples))
     shape = (len(v0), len(omega))
     maps = {key: np.full(shape, np.nan) for key in ("rop", "signed_rop", "efficiency", "efficiency_torque_magnitude",
@@ -161,6 +163,7 @@ def run_optimize(scene, out: str | Path, resume: bool = False, progress: bool = 
     opt = scene.optimize
     laws = BitRockLaws(scene.bit_rock, scene.uncertainty) if opt.samples > 0 else None
     v0, omega = grid_axis(opt.axial_velocity), grid_axis(opt.rotation_speed)
+    check_history_grid(scene)
     total = len(v0) * len(omega) * max(opt.samples, 1)
     check_memory(scene.beam.elements, scene.beam.element_degree)
     def counts() -> dict:

@@ -44,7 +44,7 @@ class PreparedScene:
     setup_time_s: float
 
 
-def prepare(scene, dynamics: bool = True) -> PreparedScene:
+def prepare(scene, dynamics: bool = True, stage=lambda name: None) -> PreparedScene:
     """Build the model and solve its static equilibrium (raises StaticFailure).
 
     A reduced model whose basis misses the string's state at rest beyond ``reduction.guard_tolerance``
@@ -54,21 +54,25 @@ def prepare(scene, dynamics: bool = True) -> PreparedScene:
     The basis's directions above the band are damped as they are with the string resting at that equilibrium
     (:meth:`~fenics_drill.model.drillstring.DrillstringModel.resting_at`).
     With ``dynamics`` and ``reduction.hyper``, a modal model's nonlinear forces are then sampled
-    (:func:`_with_element_sample`)."""
+    (:func:`_with_element_sample`).  ``stage(name)`` is told each part as it starts (a progress report)."""
     clock = time.perf_counter()
+    stage("mesh, operators, modes and the reduced basis")
     model = build_model(scene)
     initial = None
     if isinstance(model.space, ModalSpace) and scene.reduction.enrich and scene.model.gravity:
+        stage("the static state in the full order, and the responses at rest")
         model, state = _with_static_state(model, scene.reduction.guard_tolerance,
                                           scene.reduction.rest_response_tolerance)
         if state is not None:
             initial = model.space.phi.T @ (model.operators.mass @ state)  # M-orthonormal basis: the projection
     setup = time.perf_counter() - clock
+    stage("the static equilibrium on the wall")
     equilibrium = solve_static(model, initial=initial)
     model = model.resting_at(equilibrium.q)
     static = {k: v for k, v in static_report(model, equilibrium).items() if k != "contact_vertices"}
     if dynamics and scene.reduction.hyper and isinstance(model.space, ModalSpace) \
             and isinstance(model.internal, AssembledInternalForce):
+        stage(f"the element sample of the nonlinear forces (training run of {scene.reduction.hyper_training:g} s)")
         model = _with_element_sample(model, scene, equilibrium)
     return PreparedScene(model, equilibrium, static, setup)
 

@@ -12,22 +12,24 @@ import json
 import os
 import socket
 import sys
+import threading
 import time
 from pathlib import Path
 
 import numpy as np
 
 from fenics_drill.io.fields import FieldWriter
-from fenics_drill.io.files import no_room_message, write_json
+from fenics_drill.io.files import no_room_message, write_final_json, write_json
 from fenics_drill.io.output_directory import claim_output, remove_figures
 from fenics_drill.io.timeseries import TimeSeriesWriter, read_series
 from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.model.reduction.modes import drive_held_modes
-from fenics_drill.model.resources import check_memory
+from fenics_drill.model.resources import check_disk, check_memory
 from fenics_drill.observables.drilling_quantities import drilling_quantities, spin_variation_ratio
 from fenics_drill.observables.step_rows import StepRows
 from fenics_drill.scene import Time
 from fenics_drill.solvers.static import StaticFailure, static_report
+from fenics_drill.model.resolution import band_frequency, mesh_advice
 from fenics_drill.solvers.step_control import StepTooSmall, nominal_step, steps_per_band_period
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
 from fenics_drill.studies.lifecycle import StopOnSignal, command_output, uninterrupted
@@ -38,6 +40,9 @@ from fenics_drill.studies.prepare import prepare
 #: default time.band_steps is told that its efficiency (96) is not resolved: 4-7 % high at the paper's 2
 #: (docs/verification.md).
 RESOLVING_BAND_STEPS = Time.band_steps
+
+#: Fewest steps per period of the band's f_max a step may take (Nyquist); a run at fewer is "suspect".
+NYQUIST_STEPS = 2.0
 
 #: A run whose string went deeper into the wall than this share of the gap is reported "suspect": the
 #: Hunt-Crossley law (17) models a stiff wall, so a deep penetration means the time step or the contact
@@ -78,6 +83,10 @@ def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
         report = static_report(model, equilibrium)
         report["reduced_size"] = model.size
         report["basis_guard"] = model.guard
+        reasons = discretisation_reasons(scene, {"command": "static"})
+        if reasons:
+            report["suspect_reasons"] = reasons
+            summary.update(status="suspect", suspect_reasons=reasons)
         writer = FieldWriter(model.disc, out / "static.xdmf")
         writer.write(model.space.expand(equilibrium.q), 0.0)
         writer.close()
@@ -105,6 +114,33 @@ class Progress:
         done = t >= t_end * (1 - 1e-12)
         sys.stderr.write(f"\r{line}" + ("\n" if done else "") if self.terminal else f"{line}\n")
         sys.stderr.flush()
+
+
+class SetupProgress:
+    """Progress of a set-up that lasts: after ``quiet_s`` seconds, a line on stderr every ``every_s`` seconds
+    naming the part under way (a background thread, so that a long part is reported while it runs)."""
+
+    def __init__(self, enabled: bool, quiet_s: float = 5.0, every_s: float = 10.0):
+        self.enabled, self.quiet_s, self.every_s = enabled, quiet_s, every_s
+        self.current, self.started = "", time.perf_counter()
+        self.done = threading.Event()
+        if enabled:
+            threading.Thread(target=self._report, daemon=True).start()
+
+    def __call__(self, name: str) -> None:
+        self.current = name
+
+    def _report(self) -> None:
+        if self.done.wait(self.quiet_s):
+            return
+        while True:
+            sys.stderr.write(f"  set-up: {self.current} ({time.perf_counter() - self.started:.0f} s)\n")
+            sys.stderr.flush()
+            if self.done.wait(self.every_s):
+                return
+
+    def close(self) -> None:
+        self.done.set()
 
 
 class RunRecorder:
@@ -175,6 +211,7 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
     ``suspect_reasons``), failed (with when and why) or interrupted (Ctrl-C, SIGTERM)."""
     out = Path(out)
     check_memory(scene.beam.elements, scene.beam.element_degree)
+    _check_disk_for_run(scene, out)
     claim = claim_output(out, "run", overwrite)
     clock = time.perf_counter()
     summary: dict = {"command": "run", "status": "failed", "message": "", "t_end": 0.0, "steps": 0}
@@ -190,7 +227,11 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
 
     with StopOnSignal():
         try:
-            prepared = prepare(scene)
+            setup = SetupProgress(progress)
+            try:
+                prepared = prepare(scene, stage=setup)
+            finally:
+                setup.close()
             model, equilibrium = prepared.model, prepared.equilibrium
             summary["reduced_size"], summary["full_dofs"] = model.size, model.disc.ndofs
             summary["basis_guard"] = model.guard
@@ -218,6 +259,8 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
             summary["message"] = f"at t = 0 s: {failure}"
         except Exception as err:
             reached = recorder.last_state.t if recorder is not None and recorder.last_state is not None else 0.0
+            if recorder is not None and recorder.last_state is not None:
+                summary.update(_dynamics_summary(model, simulation, recorder, recorder.last_state, u0))
             room = no_room_message(err)
             summary["status"] = "failed"
             summary["message"] = (f"at t = {reached:.6g} s: cannot write the run's files: {room}" if room else
@@ -233,19 +276,35 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
     return summary
 
 
+def _check_disk_for_run(scene, out: Path) -> None:
+    """The files a run will write, at least: a time-series row per nominal step (steps refined for impacts or the
+    bit add to it) and the field snapshots, twice over while a file is updated through its copy."""
+    from fenics_drill.io.timeseries import VARIABLES
+    from fenics_drill.model.resources import dof_count
+
+    rows = scene.time.t_end / nominal_step(scene) + 1
+    series = rows * len(VARIABLES) * 8.0
+    snapshots = scene.time.t_end / scene.output.field_interval + 1 if scene.output.field_interval > 0 else 0
+    fields = snapshots * (dof_count(scene.beam.elements, 1) + 4 * scene.beam.elements) * 8.0
+    check_disk(out, 2.0 * (series + fields), f"the run's files ({rows:.3g} time-series rows for time.t_end = "
+               f"{scene.time.t_end:g} s at the nominal step, {snapshots:.3g} field snapshots at output.field_interval "
+               f"= {scene.output.field_interval:g} s)")
+
+
 def _close_run(summary: dict, out: Path, recorder, simulation, scene) -> None:
     """The last rows written and the summary completed from the files.  A disk that is full now fails the run
     with that reason, but what the files already hold is still summarised."""
     if recorder is not None:
         try:
             recorder.close(simulation.impacts_per_vertex)
-        except OSError as err:
+        except Exception as err:
             room = no_room_message(err)
             if room is None:
                 raise
-            reached = "reached time.t_end, but " if summary["status"] == "finished" else ""
-            summary["status"] = "failed"
-            summary["message"] = f"{reached}the last rows of timeseries.h5 could not be written: {room}"
+            if summary["status"] != "failed":  # the first failure is the one to report
+                reached = "reached time.t_end, but " if summary["status"] == "finished" else ""
+                summary["status"] = "failed"
+                summary["message"] = f"{reached}the last rows of timeseries.h5 could not be written: {room}"
         quantities = quantities_of_run(out / "timeseries.h5")
         if summary["status"] == "failed":  # a run that failed is no answer: what it did is kept apart
             summary["until_failure"] = quantities
@@ -261,24 +320,19 @@ def _close_run(summary: dict, out: Path, recorder, simulation, scene) -> None:
 
 
 def _write_final_summary(out: Path, summary: dict) -> None:
-    """``summary.json`` with the final status; on a full disk, the status and message alone (a few bytes more
-    may still fit), and if even that fails, the reason on stderr."""
+    """``summary.json`` with the final status, whatever the disk (:func:`write_final_json`); the reason on stderr
+    if not even the status fits."""
     try:
         write_json(out / "summary.json", summary)
         return
-    except OSError as err:
+    except Exception as err:
         room = no_room_message(err)
         if room is None:
             raise
         if summary["status"] != "failed":
             summary["status"], summary["message"] = "failed", f"summary.json could not be written: {room}"
-    try:
-        write_json(out / "summary.json", {key: summary.get(key) for key in ("command", "status", "message",
-                                                                           "t_end", "steps")})
-    except OSError:
+    if not write_final_json(out / "summary.json", summary, keep=("command", "status", "message", "t_end", "steps")):
         sys.stderr.write(f"fenics-drill: {out / 'summary.json'} could not be written ({summary['message']})\n")
-
-    return summary
 
 
 def _judge_admissibility(summary: dict, simulation: Simulation, scene) -> None:
@@ -296,10 +350,49 @@ def _judge_admissibility(summary: dict, simulation: Simulation, scene) -> None:
         reasons.append(f"{stats['forced_steps']} steps were accepted at the minimum step size with a local "
                        f"error up to {simulation.controller.worst_forced_ratio:.3g} times time.error_tolerance: "
                        "raise time.max_step_cuts or time.error_tolerance")
+    reasons += discretisation_reasons(scene, summary)
+    if summary["status"] == "finished":
+        if summary.get("efficiency", 0.0) > 1.0:
+            reasons.append(f"the efficiency is {summary['efficiency']:.3g} > 1: the run put out more work at the bit "
+                           "than the drive put in, which no resolved run does")
+        backward = -summary.get("mean_bit_velocity", 0.0) * summary.get("t_end", 0.0)  # beyond a start-up recoil
+        if scene.drive.axial_velocity > 0 and backward > SMALL_ADVANCE * scene.time.error_tolerance:
+            reasons.append(f"the bit moved backwards on average ({summary['mean_bit_velocity'] * 3600:.3g} m/h) "
+                           f"while pushed at {scene.drive.axial_velocity * 3600:.3g} m/h")
     if reasons and summary["status"] == "finished":
         summary["status"] = "suspect"
     if reasons:
         summary["suspect_reasons"] = reasons
+
+
+def discretisation_reasons(scene, summary: dict) -> list[str]:
+    """Why the mesh or the step the scene chose cannot carry its band of analysis (the reasons a run or a static
+    state is "suspect"); advice on a step that resolves the band less finely than the default."""
+    reasons = []
+    mesh = mesh_advice(scene)
+    if mesh is not None:
+        reasons.append(mesh)
+    if summary.get("command") == "static":
+        return reasons
+    band_steps = steps_per_band_period(scene)
+    largest = 1.0 / (NYQUIST_STEPS * band_frequency(scene))
+    if band_steps < NYQUIST_STEPS:
+        reasons.append(f"time.dt = {nominal_step(scene):.3g} s resolves the band's f_max = {band_frequency(scene):.4g} "
+                       f"Hz with {band_steps:.2g} steps per period, fewer than {NYQUIST_STEPS:g}: the band is not "
+                       f"resolved; use time.dt <= {largest:.3g} s, or -1 for the nominal step")
+    elif not scene.time.adaptive and band_steps < RESOLVING_BAND_STEPS * (1.0 - 1e-9):
+        reasons.append(f"a fixed step (time.adaptive = false) of {band_steps:.2g} steps per period of f_max resolves "
+                       "neither the band nor the bit's transients: use the adaptive step")
+    elif band_steps < RESOLVING_BAND_STEPS * (1.0 - 1e-9):
+        summary.setdefault("advice", []).append(
+            f"the nominal step resolves the band's f_max with {band_steps:.3g} steps per period (the default "
+            f"{RESOLVING_BAND_STEPS:g}): the efficiency (96) came out 4-7 % high at the paper's 2 on the paper scene "
+            "(docs/verification.md); compare with a run at time.dt = -1")
+    elif not scene.time.adaptive:
+        summary.setdefault("advice", []).append(
+            "a fixed step (time.adaptive = false) does not resolve the bit's start-up: on the paper scene over 0.5 s "
+            "rop was 1.8 % and the efficiency 1.0 % off the converged model at the nominal step (docs/performance.md)")
+    return reasons
 
 
 def _advise_on_energy_budget(summary: dict, scene) -> None:
@@ -358,11 +451,6 @@ def quantities_of_run(series_path: Path) -> dict:
         out["max_von_mises"] = {"value": float(stress[k]), "x": float(data["max_von_mises_x"][k]),
                                 "t": float(data["time"][k])}
     advice = []
-    band_steps = steps_per_band_period(scene)
-    if band_steps < RESOLVING_BAND_STEPS * (1.0 - 1e-9):
-        advice.append(f"the nominal step resolves the band's f_max with {band_steps:.3g} steps per period (the "
-                      f"default {RESOLVING_BAND_STEPS:g}): the efficiency (96) may come out several % high (4-7 % "
-                      "at the paper's 2, docs/verification.md); rop is not affected")
     p = scene.beam_properties
     ringing = spin_variation_ratio(data["time"], data["bit_angular_velocity"], scene.drive.rotation_speed,
                                    p.torsional_wave_speed / (4.0 * p.length))

@@ -249,7 +249,7 @@ def test_the_basis_damps_its_directions_above_the_band_and_nothing_else():
     per unit of kinetic energy (on this string 1555 Hz where f_max = 201 Hz), is among the damped."""
     import scipy.linalg as sl
 
-    from fenics_drill.model.reduction.modes import band_frequency
+    from fenics_drill.model.resolution import band_frequency
     from fenics_drill.model.reduction.out_of_band_damping import OUT_OF_BAND_FACTOR
 
     scene = load_scene(PAPER, [*STICKING, "reduction.out_of_band_damping=0.7"])

@@ -24,6 +24,7 @@ import scipy.sparse.linalg as spla
 from petsc4py import PETSc
 from slepc4py import SLEPc
 
+from fenics_drill.model.resolution import band_frequency
 from fenics_drill.model.discretization import THETA_X, THETA_Y, THETA_Z, U, V, W, BeamDiscretization
 from fenics_drill.model.operators import assemble_linear, assemble_modal_pair, field_mass_fractions
 
@@ -223,12 +224,6 @@ def paper_bands(length: float, longitudinal_wave_speed: float) -> dict[str, floa
 
 #: Harmonics of the spin the 'auto' rule keeps flexural modes for (the paper keeps 5 Hz at Omega = 1 Hz).
 SPIN_HARMONICS = 5.0
-
-
-def band_frequency(scene) -> float:
-    """f_max = f*_max c_L / L, the highest frequency of the band B [Hz]."""
-    p = scene.beam_properties
-    return scene.modal.f_star_max * p.longitudinal_wave_speed / p.length
 
 
 def step_band(scene) -> float:
