@@ -21,10 +21,21 @@ import os
 for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 
-import dolfinx_solver  # noqa: F401, E402  (must precede dolfinx / petsc4py)
-# h5py must be loaded before dolfinx.fem.petsc, whose HDF5 1.14 would otherwise be the one h5py finds
-# ("Not a datatype" at import): a notebook may import any module of the package first.
-import h5py  # noqa: F401, E402
+try:
+    import dolfinx_solver  # noqa: F401  (must precede dolfinx / petsc4py)
+    # h5py must be loaded before dolfinx.fem.petsc, whose HDF5 1.14 would otherwise be the one h5py finds
+    # ("Not a datatype" at import): a notebook may import any module of the package first.
+    import h5py  # noqa: F401
+except KeyboardInterrupt:
+    # A Ctrl-C while the libraries load (a second or two): the command-line tool ends with one line, as it does
+    # once running; anywhere else (a notebook) the interrupt goes on as usual.
+    import sys
+
+    if os.path.basename(sys.argv[0]) in ("fenics-drill", "-m", "cli.py"):
+        sys.stderr.write("fenics-drill: interrupted\n")
+        sys.stderr.flush()
+        os._exit(130)
+    raise
 
 from fenics_drill.scene import Scene, SceneError, load_scene  # noqa: E402
 

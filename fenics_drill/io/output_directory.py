@@ -43,7 +43,8 @@ OWNED = {
     "static": ("summary.json", "static.json", "static.xdmf", "static.h5"),
     "modal": ("summary.json", "modes.json"),
     "campbell": ("summary.json", "campbell.json", "campbell.png", FIGURE_RECORD),
-    "mc": ("summary.json", "scene.json", "nominal.h5", "realisations", "statistics.h5", "fig*.png", FIGURE_RECORD),
+    "mc": ("summary.json", "scene.json", "nominal.h5", "nominal.h5.corrupt", "realisations", "statistics.h5", "fig*.png",
+           FIGURE_RECORD),
     "optimize": ("summary.json", "scene.json", "points", "optimize.json", "fig*.png", FIGURE_RECORD),
 }
 SIGNATURE = {"run": "timeseries.h5", "static": "static.json", "modal": "modes.json", "campbell": "campbell.json",

@@ -85,8 +85,14 @@ def claim(out: Path, scene: dict, command: str, resume: bool, overwrite: bool, c
                 shutil.rmtree(out / RANKS, ignore_errors=True)
         except (OutputError, UnreadableFile) as err:
             error = str(err)
-    polled_barrier(comm)  # the verdict is ready on rank 0: the broadcast below does not wait
-    error = comm.bcast(error, root=0)
+    try:
+        polled_barrier(comm)  # the verdict is ready on rank 0: the broadcast below does not wait
+        error = comm.bcast(error, root=0)
+    except KeyboardInterrupt:  # stopped before the study began: what rank 0 took says so
+        if comm.rank == 0 and error is None:
+            write_json(out / "summary.json", {"command": command, "status": "interrupted",
+                                              "message": "stopped by Ctrl-C or SIGTERM before the study began"})
+        raise
     if error:
         raise OutputError(error)
     return held
