@@ -22,10 +22,15 @@ LAYERS = {
 }
 
 
+def rank_in(table: dict[str, int], module: str) -> int:
+    """The rank of the longest name of ``table`` that ``module`` is or lies under."""
+    matches = [name for name in table if module == name or module.startswith(name + ".")]
+    assert matches, f"{module} belongs to no entry of {sorted(table)}"
+    return table[max(matches, key=len)]
+
+
 def layer(module: str) -> int:
-    matches = [name for name in LAYERS if module == name or module.startswith(name + ".")]
-    assert matches, f"{module} belongs to no layer of LAYERS"
-    return LAYERS[max(matches, key=len)]
+    return rank_in(LAYERS, module)
 
 
 def modules():
@@ -61,9 +66,7 @@ MODEL_PARTS = {
 
 
 def model_part(module: str) -> int:
-    matches = [name for name in MODEL_PARTS if module == name or module.startswith(name + ".")]
-    assert matches, f"{module} belongs to no part of MODEL_PARTS"
-    return MODEL_PARTS[max(matches, key=len)]
+    return rank_in(MODEL_PARTS, module)
 
 
 def imported_modules(path: Path) -> list[str]:

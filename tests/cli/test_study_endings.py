@@ -8,7 +8,6 @@ import os
 import resource
 import signal
 import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -16,10 +15,8 @@ import pytest
 
 from fenics_drill.io.output_directory import LOCK_NAME, summary_of
 
-ROOT = Path(__file__).parents[2]
-PAPER = str(ROOT / "demos" / "scenes" / "paper.toml")
-TOOL = [sys.executable, "-m", "fenics_drill.cli"]
-MPIEXEC = str(Path(sys.executable).parent / "mpiexec")
+from test_reliability import MPIEXEC, PAPER, ROOT, TOOL  # noqa: E402  (the same command, the same scene)
+
 SMALL = ["--set", "beam.length=20", "--set", "beam.elements=40", "--set", "output.field_interval=0"]
 #: A hang shows up as a timeout of this many seconds.
 TIMEOUT = 180
@@ -156,6 +153,29 @@ def test_a_full_disk_fails_a_run_in_one_line_with_a_final_summary(tmp_path):
     summary = summary_of(out)
     assert summary["status"] == "failed" and "size limit" in summary["message"]
     assert 0 < summary["t_end"] < 5 and summary["steps"] > 0
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    """A 300 kB file system (tmpfs): where this machine lets the tests mount one (root), a disk that fills up."""
+    mount = tmp_path / "small"
+    mount.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=300k", "tmpfs", str(mount)],
+                      capture_output=True).returncode != 0:
+        pytest.skip("no tmpfs can be mounted here")
+    yield mount
+    subprocess.run(["umount", str(mount)], capture_output=True)
+
+
+def test_a_full_disk_ends_an_mpi_study_in_one_line_per_rank_with_a_failed_summary(small_disk):
+    out = small_disk / "mc"
+    result = subprocess.run([MPIEXEC, "-n", "2", *TOOL, *MC, "--samples", "40", "--out", str(out)],
+                            capture_output=True, text=True, cwd=ROOT, timeout=TIMEOUT)
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    ours = [line for line in result.stderr.splitlines() if line.startswith("fenics-drill")]
+    assert ours and all("no space left on the device" in line for line in ours)
+    summary = summary_of(out)
+    assert summary["status"] == "failed" and "no space left" in summary["message"]
 
 
 # Values the scene accepts at their edges, and resources: one line each, before any computation
