@@ -10,18 +10,22 @@ from __future__ import annotations
 
 from scene_runs import run_once, study_arguments, write_table
 
+#: The paper's friction laws (18)-(19), whose printed signs the cases switch on; the table compares laws one at a
+#: time, so every case takes them (the default is the Coulomb force at the contact point).
+PAPER_FRICTION = ["contact.friction_model=paper", "contact.sliding_velocity_scale=1e-3"]
+
 CASES = {
-    "consistent_objectivekin": ("consistent laws, objective kinematics (the default)", []),
-    "all_objectivekin": ("all three laws printed, objective kinematics", ["model.laws=printed"]),
-    "consistent_printedkin": ("consistent laws, printed kinematics (14)", ["model.kinematics=printed"]),
+    "consistent_objectivekin": ("consistent laws, objective kinematics", [*PAPER_FRICTION]),
+    "all_objectivekin": ("all three laws printed, objective kinematics", [*PAPER_FRICTION, "model.laws=printed"]),
+    "consistent_printedkin": ("consistent laws, printed kinematics (14)", [*PAPER_FRICTION, "model.kinematics=printed"]),
     "axial_printedkin": ("axial friction (18) printed, kinematics (14)",
-                         ["model.kinematics=printed", "contact.axial_friction_law=printed"]),
+                         [*PAPER_FRICTION, "model.kinematics=printed", "contact.axial_friction_law=printed"]),
     "torque_printedkin": ("friction torque (19) printed, kinematics (14)",
-                          ["model.kinematics=printed", "contact.friction_torque_law=printed"]),
+                          [*PAPER_FRICTION, "model.kinematics=printed", "contact.friction_torque_law=printed"]),
     "bit_printedkin": ("bit torque (21) printed, kinematics (14)",
-                       ["model.kinematics=printed", "bit_rock.torque_law=printed"]),
+                       [*PAPER_FRICTION, "model.kinematics=printed", "bit_rock.torque_law=printed"]),
     "all_printedkin": ("every law as printed (demos/scenes/paper_as_printed.toml)",
-                       ["model.kinematics=printed", "model.laws=printed"]),
+                       [*PAPER_FRICTION, "model.kinematics=printed", "model.laws=printed"]),
 }
 
 

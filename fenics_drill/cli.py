@@ -55,11 +55,10 @@ def cmd_modal(args) -> int:
     scene = load_scene(args.scene, args.overrides)
     report = write_modal_report(scene, args.out, overwrite=args.overwrite)
     red = report["reduced_basis"]
-    print(
-        f"{report['full_dofs']} dofs, {len(report['modes'])} modes with f* <= {scene.modal.f_star_max}, "
-        f"reduced basis ({scene.reduction.rule}): {red['size']} = {red['counts']} "
-        f"[{report['wall_time_s']:.1f} s] -> {Path(args.out) / 'modes.json'}"
-    )
+    chosen = (f"reduced basis ({scene.reduction.rule}): {red['size']} = {red['counts']}" if red["counts"] else
+              f"full order ({scene.reduction.rule}{': ' + red['guard']['full_order']['why'] if 'guard' in red else ''})")
+    print(f"{report['full_dofs']} dofs, {len(report['modes'])} modes with f* <= {scene.modal.f_star_max}, {chosen} "
+          f"[{report['wall_time_s']:.1f} s] -> {Path(args.out) / 'modes.json'}")
     return 0
 
 

@@ -109,14 +109,16 @@ class Contact:
     stiffness_linear: float = _nonneg("k_FS1 of Eq. (17) [N/m]", 1e10)
     stiffness_cubic: float = _nonneg("k_FS2 of Eq. (17) [N/m^3]", 1e16)
     damping: float = _nonneg("c_FS of Eq. (17) [N s/m^4; N s^4/m^4 with damper_law = printed]", 1e6)
-    friction: float = _nonneg("mu_FS of Eqs. (18)-(19) [-]", 0.25)
+    friction: float = _nonneg("wall friction coefficient mu_FS [-]", 0.25)
+    friction_model: str = key("coulomb", "'coulomb' (one force opposing the contact point's slip) or 'paper' "
+                              "((18)-(19))", choices=("coulomb", "paper"))
     axial_friction_law: str = key("model", "the axial friction (18): 'consistent', 'printed', or 'model' "
                                   "(as model.laws says)", choices=("model", "consistent", "printed"))
     friction_torque_law: str = key("model", "the friction torque (19): 'consistent', 'printed', or 'model' "
                                    "(as model.laws says)", choices=("model", "consistent", "printed"))
     damper_law: str = key("consistent", "the damper of (17): 'consistent' (c |delta|^3 delta_dot), 'printed' or "
                           "'model'", choices=("model", "consistent", "printed"))
-    sliding_velocity_scale: float = _pos("v_s of the regularised sgn(v) = tanh(v / v_s) in (18)-(19) [m/s]", 1e-3)
+    sliding_velocity_scale: float = _pos("slip speed v_s of the regularised Coulomb law tanh(|s| / v_s) [m/s]", 1e-5)
     culling: bool = key(True, "evaluate the wall law only where a vertex can reach the wall (exact)")
 
 @dataclass(frozen=True)
@@ -415,6 +417,13 @@ def _check_relations(scene: Scene) -> Scene:
         raise SceneError(f"output.section = {scene.output.section!r} is not admissible: "
                          f"must be in [0, beam.length = {beam.length!r}]")
     _check_stabilisers(scene)
+    contact = scene.contact
+    if contact.friction_model == "coulomb":
+        for name in ("axial_friction_law", "friction_torque_law"):
+            if scene.law(getattr(contact, name)) == "printed":
+                raise SceneError(f"contact.{name} = 'printed' (through model.laws or itself) is not admissible with "
+                                 "contact.friction_model = 'coulomb': the printed signs belong to the paper's laws "
+                                 "(18)-(19); set contact.friction_model = 'paper'")
     if scene.model.contact and scene.contact.stiffness_linear == 0:
         raise SceneError("contact.stiffness_linear = 0.0 is not admissible with model.contact = true: without "
                          "its linear spring the wall lets the string through (k_FS2 delta^3 is negligible at small "

@@ -1,6 +1,8 @@
 """Displacement and rotation fields for ParaView: XDMF with u, v, w, theta_x, theta_y, theta_z on the
 vertices, the displacement vector (u, v, w) for "Warp By Vector", and, for drilling runs, the
-element-wise maximum von Mises stress ``von_mises`` (Pa); the one writer (:class:`FieldWriter`) and the
+element-wise maximum von Mises stress ``von_mises`` (Pa), the axial force and torque along the string
+(``axial_force`` [N], ``torque`` [N m], element-wise) and the wall's normal force per length
+(``wall_normal_force_per_length`` [N/m], at the vertices); the one writer (:class:`FieldWriter`) and the
 one reader (:class:`FieldSnapshots`) of ``fields.xdmf`` + ``fields.h5``.
 
 The vertex values are the Lagrange fields' nodal values (what P1 interpolation gives).  The
@@ -47,14 +49,19 @@ class FieldWriter:
     """Writes the fields of full-space dof vectors at chosen times, whole files at every moment."""
 
     def __init__(self, disc: BeamDiscretization, path: str | Path, with_stress: bool = False,
-                 clock: FlushClock | None = None):
+                 clock: FlushClock | None = None, with_profiles: bool = False):
+        """``with_stress``: each snapshot has the cells' von Mises maxima; ``with_profiles``: the axial force and
+        torque on the cells and the wall's normal force per length at the vertices, given along x."""
         self.xdmf = Path(path)
         self.h5 = self.xdmf.with_suffix(".h5")
         self.vertex_dofs = [disc.vertex_dofs(i) for i in range(len(FIELD_NAMES))]
         x = disc.mesh.geometry.x[:, 0]
         cell_vertices = disc.mesh.geometry.dofmaps[0]
         self.cell_order = np.argsort(0.5 * (x[cell_vertices[:, 0]] + x[cell_vertices[:, 1]]))
+        self.vertex_order = np.argsort(disc.vertex_x)
         self.with_stress = with_stress
+        self.profile_cells = ("axial_force", "torque") if with_profiles else ()
+        self.profile_points = ("wall_normal_force_per_length",) if with_profiles else ()
         self.nodes, self.cells = len(disc.vertex_x), len(self.cell_order)
         self.clock = clock or FlushClock()
         self.pending: list[tuple[float, dict]] = []
@@ -71,13 +78,21 @@ class FieldWriter:
         write_atomic(self.h5, create)
         self._write_index()
 
-    def write(self, dofs: np.ndarray, t: float, cell_stress: np.ndarray | None = None) -> None:
-        """The fields at time t, and the element-wise maximum von Mises stress if given [Pa]; written to
-        disk when the clock says so (or at :meth:`flush`)."""
+    def write(self, dofs: np.ndarray, t: float, cell_stress: np.ndarray | None = None,
+              profiles: dict[str, np.ndarray] | None = None) -> None:
+        """The fields at time t, the element-wise maximum von Mises stress if given [Pa], and the ``profiles``
+        (:func:`fenics_drill.observables.torque_drag.string_profiles`, along x); written to disk when the clock
+        says so (or at :meth:`flush`)."""
         values = {name: dofs[rows][:, None] for name, rows in zip(FIELD_NAMES, self.vertex_dofs)}
         values["displacement"] = np.column_stack([dofs[self.vertex_dofs[i]] for i in range(3)])
         if self.with_stress and cell_stress is not None:
             values["von_mises"] = np.asarray(cell_stress)[self.cell_order][:, None]
+        for name in self.profile_cells:
+            values[name] = np.asarray(profiles[name])[:, None]  # cells along x, as the index orders them
+        for name in self.profile_points:
+            at_vertices = np.empty(self.nodes)
+            at_vertices[self.vertex_order] = profiles[name]
+            values[name] = at_vertices[:, None]
         self.pending.append((t, values))
         if self.clock.due():
             self.flush()
@@ -110,8 +125,12 @@ class FieldWriter:
                                   h5=self.h5.name, key=snapshot_key(t)) for name in FIELD_NAMES)
             attributes += _ATTRIBUTE.format(name="displacement", kind="Vector", center="Node", rows=self.nodes,
                                             columns=3, h5=self.h5.name, key=snapshot_key(t))
-            if self.with_stress:
-                attributes += _ATTRIBUTE.format(name="von_mises", kind="Scalar", center="Cell", rows=self.cells,
+            cells = (("von_mises",) if self.with_stress else ()) + self.profile_cells
+            for name in cells:
+                attributes += _ATTRIBUTE.format(name=name, kind="Scalar", center="Cell", rows=self.cells,
+                                                columns=1, h5=self.h5.name, key=snapshot_key(t))
+            for name in self.profile_points:
+                attributes += _ATTRIBUTE.format(name=name, kind="Scalar", center="Node", rows=self.nodes,
                                                 columns=1, h5=self.h5.name, key=snapshot_key(t))
             grids.append(_GRID.format(t=float(t), cells=self.cells, nodes=self.nodes, h5=self.h5.name,
                                       attributes=attributes))

@@ -4,6 +4,8 @@ realisation keeps.  :data:`VARIABLES` names them with their units; the point for
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -11,6 +13,7 @@ from fenics_drill.model.discretization import THETA_X
 from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.model.forces import recorded_variables
 from fenics_drill.observables.von_mises import VonMisesProbe
+from fenics_drill.observables.whirl import slip_velocity
 from fenics_drill.solvers.time_loop import StepRecord
 
 #: name: (units, long name) of every per-step variable that does not belong to a point force.
@@ -34,6 +37,9 @@ STATE_VARIABLES = {
     "section_v_velocity": ("m/s", "lateral velocity v_dot at the recorded section"),
     "section_w_velocity": ("m/s", "lateral velocity w_dot at the recorded section"),
     "section_theta_x_velocity": ("rad/s", "angular velocity theta_x_dot at the recorded section"),
+    "section_orbit_angle": ("rad", "angle of the recorded section's centre in the hole, atan2(w, v)"),
+    "section_slip_velocity": ("m/s", "slip of the section's surface facing the wall, t . (v_dot, w_dot) + R_ext "
+                              "theta_x_dot with t = (-w, v) / r: zero when it rolls on the wall"),
     "max_von_mises": ("Pa", "maximum von Mises stress over the string (NaN if output.von_mises is off)"),
     "max_von_mises_x": ("m", "x where the maximum von Mises stress sits"),
     "kinetic_energy": ("J", "kinetic energy, Eq. (24)"),
@@ -64,6 +70,7 @@ class StepRows:
         disc = model.disc
         section = int(np.argmin(np.abs(disc.vertex_x - scene.output.section)))
         self.section_x = float(disc.vertex_x[section])
+        self.outer_radius = disc.properties.outer_radius
         v_rows, w_rows = model.lateral_rows
         tx_rows = model.space.rows(disc.vertex_dofs(THETA_X))
         # u(L), theta_x(L), then v, w, theta_x at the section, then u(0), theta_x(0): one product gives them all
@@ -102,7 +109,9 @@ class StepRows:
                          "bit_displacement": u, "bit_velocity": du, "bit_rotation": tx,
                          "bit_angular_velocity": dtx, "section_v": v, "section_w": w, "section_v_velocity": dv,
                          "section_w_velocity": dw, "section_theta_x_velocity": dsx, "top_velocity": du_top,
-                         "top_angular_velocity": dtx_top, "max_von_mises": stress, "max_von_mises_x": stress_x})
+                         "top_angular_velocity": dtx_top, "max_von_mises": stress, "max_von_mises_x": stress_x,
+                         "section_orbit_angle": math.atan2(w, v),
+                         "section_slip_velocity": float(slip_velocity(v, w, dv, dw, dsx, self.outer_radius))})
         self._pending.clear()  # only now: a row interrupted while computed is still pending
         return rows
 

@@ -18,7 +18,8 @@ import numpy as np
 from fenics_drill.io.files import write_json
 from fenics_drill.io.timeseries import read_modes, read_series
 from fenics_drill.observables.spectra import run_spectra
-from fenics_drill.plots.common import M_PER_S_TO_M_PER_H, RAD_PER_S_TO_RPM, panels, save_figure
+from fenics_drill.io.fields import FieldSnapshots
+from fenics_drill.plots.common import M_PER_S_TO_M_PER_H, RAD_PER_S_TO_RPM, panels, plt, save_figure
 from fenics_drill.plots.pictures import make_pictures
 
 
@@ -64,6 +65,52 @@ def time_series_figures(data: dict, attrs: dict, out: Path) -> list[Path]:
         ax.text(0.5, 0.5, "no impact in this run", transform=ax.transAxes, ha="center", va="center", color="0.4")
     paths += [path18, save_figure(fig, out / "fig19_impacts_position.png")]
     return paths
+
+
+def orbit_figure(data: dict, attrs: dict, path: Path) -> Path:
+    """The recorded section's centre in the hole, coloured by time, with the wall the centre reaches (the gap
+    circle), as seen from the top looking towards the bit."""
+    gap, x_s = float(attrs.get("gap", np.nan)), float(attrs["section_x"])
+    fig, ax = plt.subplots(figsize=(6, 5.4))
+    points = ax.scatter(data["section_v"] * 1e3, data["section_w"] * 1e3, c=data["time"], s=2, cmap="viridis",
+                        linewidths=0)
+    if np.isfinite(gap):
+        angle = np.linspace(0, 2 * np.pi, 361)
+        ax.plot(gap * 1e3 * np.cos(angle), gap * 1e3 * np.sin(angle), "k-", lw=1, label="wall (centre at the gap)")
+        ax.legend(loc="upper right", fontsize=8)
+        ax.set_xlim(-1.15 * gap * 1e3, 1.15 * gap * 1e3)
+        ax.set_ylim(-1.15 * gap * 1e3, 1.15 * gap * 1e3)
+    ax.set_aspect("equal")
+    ax.grid(alpha=0.3)
+    ax.set(xlabel="v, horizontal [mm]", ylabel="w, vertical [mm]", title=f"Orbit of the section at x = {x_s:g} m")
+    fig.colorbar(points, ax=ax, label="time [s]")
+    return save_figure(fig, path)
+
+
+def torque_drag_figure(snapshots: FieldSnapshots, path: Path) -> Path | None:
+    """Axial force, torque and the wall's normal force per length along the string, as torque-and-drag plots show
+    them: the last snapshot, the mean over the second half of the snapshots and their range.  None if the field
+    file holds no profiles (a run of an older version)."""
+    cells, points = snapshots.cell_fields, snapshots.fields
+    if "axial_force" not in cells or "torque" not in cells:
+        return None
+    x_mid = 0.5 * (snapshots.x[1:] + snapshots.x[:-1])
+    late = snapshots.times >= 0.5 * snapshots.times[-1]
+    panels_ = [(x_mid, cells["axial_force"] / 1e3, "axial force [kN] (tension +)"),
+               (x_mid, cells["torque"] / 1e3, "torque [kN m]")]
+    if "wall_normal_force_per_length" in points:
+        panels_.append((snapshots.x, points["wall_normal_force_per_length"] / 1e3, "wall normal force [kN/m]"))
+    fig, axes = panels(len(panels_), 2.6)
+    for ax, (x, values, label) in zip(axes, panels_):
+        ax.fill_between(x, values[late].min(axis=0), values[late].max(axis=0), color="tab:blue", alpha=0.2,
+                        lw=0, label="range, second half")
+        ax.plot(x, values[late].mean(axis=0), color="tab:blue", lw=1.2, label="mean, second half")
+        ax.plot(x, values[-1], color="k", lw=0.8, ls="--", label=f"t = {snapshots.times[-1]:.3g} s")
+        ax.set_ylabel(label)
+    axes[0].legend(fontsize=8, loc="best")
+    axes[-1].set_xlabel("x along the string (0: the drive, L: the bit) [m]")
+    axes[0].set_title("Torque and drag along the string")
+    return save_figure(fig, path)
 
 
 def _peak_label(peak: dict) -> str:
@@ -120,6 +167,11 @@ def plot_run(run_dir: Path, gif: bool = True) -> list[Path]:
     """Every figure of a run directory; returns the files written."""
     data, attrs = read_series(run_dir / "timeseries.h5")
     paths = time_series_figures(data, attrs, run_dir)
+    paths.append(orbit_figure(data, attrs, run_dir / "fig16b_orbit.png"))
+    if (run_dir / "fields.h5").exists():
+        profiles = torque_drag_figure(FieldSnapshots(run_dir / "fields.h5"), run_dir / "torque_drag.png")
+        if profiles is not None:
+            paths.append(profiles)
     spectra = run_spectra_of(run_dir)
     paths += spectra_figures(spectra, run_dir)
     write_json(run_dir / "spectra.json", spectra_json(spectra))

@@ -70,7 +70,7 @@ def residual_at(internal, forces, order, constraints, drive_loads, q, qd, qdd, m
         elif kind == WALL:
             within = np.dot(column_bound, np.abs(q - q_ref)) < reach
             wall = WALL_PASS(wall_rows, q.size, q, qd, law[0], law[1], law[2], law[3], law[4], law[5], law[6], law[7],
-                             law[8])
+                             law[8], law[9])
             external += wall[4]
         elif kind == BIT_ROCK:
             rates = np.dot(bit_rows, qd)

@@ -58,11 +58,11 @@ class Simulation:
         self._next_sampling_check = 0.0
         self.last_state: State | None = None  # the latest accepted state (what an interrupted run keeps)
 
-    def initial_state(self, q0: np.ndarray) -> State:
-        """Displacement q0 (the static equilibrium), velocity (V0, Omega) of Section 3.2, and the
+    def initial_state(self, q0: np.ndarray, qd0: np.ndarray | None = None) -> State:
+        """Displacement q0 (the static equilibrium), velocity (V0, Omega) of Section 3.2 (or ``qd0``), and the
         consistent acceleration and multipliers; the memories of the model start here."""
         self.model.begin(0.0, q0)
-        qd0 = self.model.drive_velocity_field()
+        qd0 = self.model.drive_velocity_field() if qd0 is None else qd0
         qdd0, mu = self.stepper.initial_acceleration(q0, qd0)
         return State(0.0, q0, qd0, qdd0, mu)
 

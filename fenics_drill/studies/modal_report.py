@@ -43,6 +43,9 @@ def modal_report(scene) -> dict:
     }
     if scene.reduction.rule == "none":  # full order: the FE space itself, no modal basis
         reduced = {"rule": "none", "size": disc.ndofs, "counts": None, "mode_indices": None}
+    elif "full_order" in guard:  # the 'auto' rule chose the full order (the guard says why)
+        reduced = {"rule": scene.reduction.rule, "size": disc.ndofs, "counts": None, "mode_indices": None,
+                   "unknowns": disc.ndofs, "guard": guard}
     return {
         "full_dofs": disc.ndofs,
         "element_degree": disc.element_degree,

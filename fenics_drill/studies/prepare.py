@@ -18,7 +18,7 @@ import numpy as np
 
 from fenics_drill.model.drillstring import DrillstringModel, build_model
 from fenics_drill.model.reduction.enrichment import (basis_error, bit_loads, missed_share, tangent_responses,
-                                             wall_friction_loads)
+                                                     wall_friction_loads)
 from fenics_drill.model.reduction.hyper_reduction import train_sample
 from fenics_drill.model.internal_force import AssembledInternalForce
 from fenics_drill.model.reduction.spaces import ModalSpace
@@ -157,7 +157,8 @@ def _with_responses_at_rest(model: DrillstringModel, full: DrillstringModel, equ
     loads = bit_loads(model.disc) if model.force("bit_rock") is not None else {}
     wall = evaluation.forces.get("wall")
     if wall is not None and model.scene.contact.friction > 0 and wall.delta.max(initial=0.0) > 0:
-        loads.update(wall_friction_loads(model.disc, space.expand(wall.generalised)))
+        loads.update(wall_friction_loads(model.disc, space.expand(wall.generalised),
+                                         model.scene.contact.friction_model == "coulomb"))
     if not loads:
         return model
     responses = {name: response for name, response in

@@ -22,11 +22,14 @@ from fenics_drill.io.fields import FieldWriter
 from fenics_drill.io.files import no_room_message, write_final_json, write_json
 from fenics_drill.io.output_directory import claim_output, remove_figures
 from fenics_drill.io.timeseries import TimeSeriesWriter, read_series
+from fenics_drill.model.discretization import THETA_X, U, V, W
 from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.model.reduction.modes import drive_held_modes
 from fenics_drill.model.resources import check_disk, check_memory
 from fenics_drill.observables.drilling_quantities import drilling_quantities, spin_variation_ratio
 from fenics_drill.observables.step_rows import StepRows
+from fenics_drill.observables.torque_drag import string_profiles, top_loads
+from fenics_drill.observables.whirl import whirl
 from fenics_drill.scene import Time
 from fenics_drill.solvers.static import StaticFailure, static_report
 from fenics_drill.model.resolution import band_frequency, mesh_advice
@@ -160,8 +163,11 @@ class RunRecorder:
             "reduced_size": model.size,
         }, model.modes, held_modes=held)
         self.field_interval = scene.output.field_interval
-        self.fields = FieldWriter(model.disc, out / "fields.xdmf", with_stress=self.rows.stress is not None) \
-            if self.field_interval > 0 else None
+        self.fields = FieldWriter(model.disc, out / "fields.xdmf", with_stress=self.rows.stress is not None,
+                                  with_profiles=True) if self.field_interval > 0 else None
+        contact = scene.contact
+        self.profile_law = (model.gap, contact.stiffness_linear if scene.model.contact else 0.0,
+                            contact.stiffness_cubic if scene.model.contact else 0.0)
         self.next_field_time = 0.0
         # the latest state taken (what an interrupted run reports): its row is in the series at the latest when
         # the recorder closes
@@ -171,7 +177,10 @@ class RunRecorder:
         if self.fields is not None and state.t >= self.next_field_time - 1e-12:
             dofs = self.model.space.expand(state.q)
             stress = self.rows.stress.cell_stress(dofs) if self.rows.stress is not None else None
-            self.fields.write(dofs, state.t, stress)
+            disc = self.model.disc
+            u, v, w, tx = (dofs[disc.vertex_dofs(f)] for f in (U, V, W, THETA_X))
+            profiles = string_profiles(disc.vertex_x, u, v, w, tx, disc.properties, *self.profile_law)
+            self.fields.write(dofs, state.t, stress, profiles)
             self.next_field_time = self.field_interval * (np.floor(state.t / self.field_interval + 1e-9) + 1)
 
     def __call__(self, record: StepRecord) -> None:
@@ -235,6 +244,7 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
             model, equilibrium = prepared.model, prepared.equilibrium
             summary["reduced_size"], summary["full_dofs"] = model.size, model.disc.ndofs
             summary["basis_guard"] = model.guard
+            summary["discretisation"] = _discretisation(model, scene)
             summary["setup_time_s"], summary["static"] = prepared.setup_time_s, prepared.static
             simulation = Simulation(model, scene)
             start = simulation.initial_state(equilibrium.q)
@@ -274,6 +284,15 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
                 remove_figures(out)
                 claim.release()
     return summary
+
+
+def _discretisation(model, scene) -> dict:
+    """Which space the run took and why: the modal basis of ``reduction.rule``, or the full order (asked for, or
+    chosen by the 'auto' rule where no modal basis can be trusted)."""
+    full = model.space.sparse  # the full space's [Phi] is a sparse selection of the free dofs
+    why = model.guard.get("full_order", {}).get("why") if full else None
+    return {"space": "full order" if full else "modal", "unknowns": model.size, "rule": scene.reduction.rule,
+            **({"why": why} if why else {})}
 
 
 def _check_disk_for_run(scene, out: Path) -> None:
@@ -445,6 +464,12 @@ def quantities_of_run(series_path: Path) -> dict:
         return {}
     scene = attrs["scene"]
     out = drilling_quantities(data, scene.drive.axial_velocity, scene.drive.rotation_speed)
+    out["torque_and_drag"] = top_loads(data["time"], data["lambda_1"], data["lambda_4"])
+    if "section_orbit_angle" in data:  # series written before the whirl was recorded have none
+        out["whirl"] = {"section": {"x": float(attrs["section_x"]), **whirl(
+            data["time"], data["section_v"], data["section_w"], data["section_v_velocity"], data["section_w_velocity"],
+            data["section_theta_x_velocity"], float(attrs["gap"]), scene.beam.outer_radius)},
+            "bit": {"direction": "none", "held": True, "why": "model.supports holds v and w at the bit"}}
     stress = data["max_von_mises"]
     if np.isfinite(stress).any():
         k = int(np.nanargmax(stress))

@@ -29,7 +29,7 @@ def test_an_interrupt_that_arrives_inside_a_kernel_is_a_keyboard_interrupt():
             timer.start()
             with pytest.raises(KeyboardInterrupt):
                 for _ in range(200000):
-                    _vertex_loads(lateral, rates, 0.5, 1.0, 1.0, 1.0, False, 0.2, 0.2, 0.1, 1e-4)
+                    _vertex_loads(lateral, rates, 0.5, 1.0, 1.0, 1.0, False, 0.2, 0.2, 0.1, 1e-4, True)
             timer.join()
     finally:
         signal.signal(signal.SIGUSR1, previous)

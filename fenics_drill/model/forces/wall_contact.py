@@ -1,11 +1,19 @@
 """Wall impacts at the mesh vertices, Eqs. (16)-(19), (40), (50), with their tangents.
 
-Every vertex carries the Hunt-Crossley normal force (17) (damper c |delta|^3 delta_dot),
-the axial friction force (18) and the friction torque (19) in their physically
-consistent form (docs/errata.md): the normal force never pulls the string towards the
-wall, and friction never does positive work.  The pointwise laws come first, then
-:class:`WallContact` projects them on the solution space and differentiates them
-for the Newton tangent.
+Every vertex in contact carries the Hunt-Crossley normal force (17) (damper c |delta|^3 delta_dot) and friction,
+by one of two laws (``contact.friction_model``):
+
+- ``coulomb`` (the default): one Coulomb force at the contact point, opposing the slip velocity of the pipe's
+  surface against the wall, s = (u_dot, t . (v_dot, w_dot) + R_ext theta_x_dot), with t the wall's tangent in
+  the cross-section: F = -mu |F_n| tanh(|s| / v_s) s / |s|.  It acts as an axial force, a lateral force along t
+  and a torque R_ext F_t about the pipe's axis, and never does positive work (power -mu |F_n| |s| tanh(|s|/v_s)).
+  So rotation takes the drag away (the axial share is u_dot / |s|), and the string can climb the wall, roll
+  and whirl.
+- ``paper``: (18) and (19) as two separate laws, -mu |F_n| sgn(u_dot) and -mu |F_n| R_bh sgn(theta_x_dot), with
+  the borehole radius as the torque's arm (docs/errata.md); their signs as printed are a further option.
+
+The pointwise laws come first, then :class:`WallContact` projects them on the solution space and differentiates
+them for the Newton tangent.
 """
 
 from __future__ import annotations
@@ -115,11 +123,44 @@ _FRICTION = np.vectorize(_friction, otypes=(float, float))
 
 
 @njit(cache=True, inline="always")
-def _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s, delta, nodal,
-                laws):
+def _slip_factor(slip, velocity_scale):
+    """g(|s|) = tanh(|s| / v_s) / |s|, the regularised Coulomb force being -mu |F_n| g s, and (dg/d|s|) / |s|
+    (its derivative is -mu |F_n| (g I + (dg/d|s|) / |s| s s^T)); both finite at s = 0."""
+    y = slip / velocity_scale
+    if y < 1e-4:  # the series of tanh(y) / y: 1 - y^2 / 3
+        return (1.0 - y * y / 3.0) / velocity_scale, -2.0 / (3.0 * velocity_scale**3)
+    if y > SATURATED:
+        return 1.0 / slip, -1.0 / slip**3
+    th = np.tanh(y)
+    g = th / slip
+    return g, ((1.0 - th * th) / velocity_scale - g) / (slip * slip)
+
+
+@njit(cache=True, inline="always")
+def _coulomb(normal_force, axial_slip, tangential_slip, friction, velocity_scale):
+    """The Coulomb force at the contact point, (F_a, F_t) = -mu |F_n| tanh(|s| / v_s) s / |s|."""
+    g = _slip_factor(np.hypot(axial_slip, tangential_slip), velocity_scale)[0]
+    magnitude = friction * abs(normal_force)
+    return -magnitude * g * axial_slip, -magnitude * g * tangential_slip
+
+
+def coulomb_friction(normal_force, axial_slip, tangential_slip, friction, velocity_scale):
+    """One Coulomb force opposing the slip velocity of the contact point (axial and tangential components):
+    (F_a, F_t) = -mu |F_n| tanh(|s| / v_s) s / |s|.  Its magnitude is mu |F_n| tanh(|s| / v_s) <= mu |F_n|."""
+    return _COULOMB(normal_force, axial_slip, tangential_slip, friction, velocity_scale)
+
+
+_COULOMB = np.vectorize(_coulomb, otypes=(float, float))
+
+
+@njit(cache=True, inline="always")
+def _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s, coulomb, delta,
+                nodal, laws):
     """Eqs. (16)-(19) at vertex i with lateral position (v, w) and rates (u, v, w, theta_x)_dot (row i of
     ``rates``, read in place: a row view per vertex costs more than the law out of contact): its
-    indentation, nodal loads and the loads of each law; returns the springs' energy."""
+    indentation, nodal loads and the loads of each law (the damper; the axial friction; the friction torque, or
+    with ``coulomb`` the tangential part of the one friction force, lateral and torque); returns the springs'
+    energy.  ``arm``: the friction torque's arm, R_ext for the Coulomb force at the contact point, R_bh in (19)."""
     r = np.hypot(v, w)
     d = r - gap
     delta[i] = d
@@ -127,30 +168,38 @@ def _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torq
         return 0.0
     n_v, n_w = v / r, w / r
     normal = _normal_force(d, n_v * rates[i, 1] + n_w * rates[i, 2], k1, k2, damping, printed)
-    axial, torque = _friction(normal, rates[i, 0], rates[i, 3], mu_axial, mu_torque, radius_bh, v_s)
-    nodal[i, 0], nodal[i, 1], nodal[i, 2], nodal[i, 3] = axial, normal * n_v, normal * n_w, torque
     damper = normal + k1 * d + k2 * d**3  # with the clip that keeps the wall from pulling
     laws[i, 1, 0], laws[i, 2, 0] = damper * n_v, damper * n_w
-    laws[i, 0, 1] = axial
-    laws[i, 3, 2] = torque
+    if coulomb:  # t = (-n_w, n_v): the wall's tangent, the direction the contact point turns with theta_x
+        tangential_slip = -n_w * rates[i, 1] + n_v * rates[i, 2] + arm * rates[i, 3]
+        axial, tangential = _coulomb(normal, rates[i, 0], tangential_slip, mu_axial, v_s)
+        nodal[i, 0], nodal[i, 3] = axial, arm * tangential
+        nodal[i, 1], nodal[i, 2] = normal * n_v - tangential * n_w, normal * n_w + tangential * n_v
+        laws[i, 0, 1] = axial
+        laws[i, 1, 2], laws[i, 2, 2], laws[i, 3, 2] = -tangential * n_w, tangential * n_v, arm * tangential
+    else:
+        axial, torque = _friction(normal, rates[i, 0], rates[i, 3], mu_axial, mu_torque, arm, v_s)
+        nodal[i, 0], nodal[i, 1], nodal[i, 2], nodal[i, 3] = axial, normal * n_v, normal * n_w, torque
+        laws[i, 0, 1] = axial
+        laws[i, 3, 2] = torque
     return 0.5 * k1 * d**2 + 0.25 * k2 * d**4
 
 
 @kernel
-def _vertex_loads(lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s):
+def _vertex_loads(lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s, coulomb):
     """Eqs. (16)-(19) at every vertex: indentation, nodal loads (F_a, F_v, F_w, T), the loads of the
-    damper, the axial friction and the friction torque (vertex, field, law), and the springs' energy."""
+    damper and of the two parts of friction (vertex, field, law), and the springs' energy."""
     n = lateral.shape[0]
     delta, nodal, laws = np.empty(n), np.zeros((n, 4)), np.zeros((n, 4, 3))
     potential = 0.0
     for i in range(n):
         potential += _vertex_law(i, lateral[i, 0], lateral[i, 1], rates, gap, k1, k2, damping, printed,
-                                 mu_axial, mu_torque, radius_bh, v_s, delta, nodal, laws)
+                                 mu_axial, mu_torque, arm, v_s, coulomb, delta, nodal, laws)
     return delta, nodal, laws, potential
 
 
 @kernel(fastmath=REASSOCIATE)
-def _modal_pass(packed, size, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s):
+def _modal_pass(packed, size, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s, coulomb):
     """:func:`_vertex_loads` in a modal space (``size`` coordinates), in one pass over the rows of [Phi] of
     (u, v, w, theta_x) at each vertex, interleaved and packed by field (``packed``: :meth:`~fenics_drill.model.
     packed_rows.FieldPackedRows.kernel_data`, groups in the order of FIELDS): each vertex's positions and
@@ -174,8 +223,8 @@ def _modal_pass(packed, size, q, qd, gap, k1, k2, damping, printed, mu_axial, mu
         lateral[i, 0], lateral[i, 1] = v, w
         rates[i, 0], rates[i, 1] = dot_row(values, r, qd_u, c_u), rate_v
         rates[i, 2], rates[i, 3] = rate_w, dot_row(values, r + 3, qd_t, c_t)
-        potential += _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh,
-                                 v_s, delta, nodal, laws)
+        potential += _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s,
+                                 coulomb, delta, nodal, laws)
         if delta[i] > 0.0:
             add_row(load_u, values, r, nodal[i, 0], c_u)
             add_row(load_v, values, r + 1, nodal[i, 1], c_v)
@@ -192,17 +241,17 @@ MODAL_PASS = _modal_pass.compiled
 
 @kernel(fastmath=REASSOCIATE)
 def _projected_laws(packed, size, delta, laws):
-    """[Phi]^T of the loads of the damper, the axial friction and the friction torque (rows of the result),
-    over the vertices in contact (delta > 0) of the packed rows of :func:`_modal_pass`."""
+    """[Phi]^T of the loads of each law (the damper and the two parts of friction: rows of the result), over the
+    vertices in contact (delta > 0) of the packed rows of :func:`_modal_pass`."""
     values, _, columns, counts = packed
     by_law = np.zeros((3,) + columns.shape)  # each law's packed sums, by field
     for i in range(delta.size):
         if delta[i] > 0.0:
             r = 4 * i
-            add_row(by_law[0, 1], values, r + 1, laws[i, 1, 0], counts[1])
-            add_row(by_law[0, 2], values, r + 2, laws[i, 2, 0], counts[2])
-            add_row(by_law[1, 0], values, r, laws[i, 0, 1], counts[0])
-            add_row(by_law[2, 3], values, r + 3, laws[i, 3, 2], counts[3])
+            for law in range(3):
+                for f in range(4):
+                    if laws[i, f, law] != 0.0:
+                        add_row(by_law[law, f], values, r + f, laws[i, f, law], counts[f])
     projected = np.zeros((3, size))
     for law in range(3):
         scatter(projected[law], columns, counts, by_law[law])
@@ -210,7 +259,7 @@ def _projected_laws(packed, size, delta, laws):
 
 
 @kernel
-def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, radius_bh, v_s,
+def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s, coulomb,
                     c_u, c_v):
     """c_u d(F_a, F_v, F_w, T)/d(u, v, w, theta_x) + c_v d(...)/d(velocities) at every vertex in contact:
     one 4 x 4 block per vertex, rows and columns in the order of FIELDS."""
@@ -232,6 +281,11 @@ def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_ax
         # d delta_rate / d(v_dot, w_dot) = n
         dfn_v = c_u * (spring * n_v + damper_by_rate * (dv - d_rate * n_v) / r) + c_v * damper_by_rate * n_v
         dfn_w = c_u * (spring * n_w + damper_by_rate * (dw - d_rate * n_w) / r) + c_v * damper_by_rate * n_w
+        if coulomb:
+            _coulomb_block(blocks[k], normal, dfn_v, dfn_w, n_v, n_w, r, d_rate, dv, dw, rates[i, 0], rates[i, 3],
+                           mu_axial, arm, v_s, c_u, c_v)
+            continue
+        radius_bh = arm
         s_a = _regularised_sign(rates[i, 0], v_s)
         s_t = _regularised_sign(radius_bh * rates[i, 3], v_s)
         fa, ft = mu_axial * s_a, mu_torque * radius_bh * s_t  # F_a = fa F_n, T = ft F_n
@@ -246,6 +300,39 @@ def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_ax
         b[0, 0] = c_v * mu_axial * normal * (1.0 - s_a * s_a) / v_s
         b[3, 3] = c_v * mu_torque * radius_bh * normal * (1.0 - s_t * s_t) * radius_bh / v_s
     return blocks
+
+
+@njit(cache=True, inline="always")
+def _coulomb_block(b, normal, dfn_v, dfn_w, n_v, n_w, r, d_rate, dv, dw, du, dtheta, mu, arm, v_s, c_u, c_v):
+    """The 4 x 4 block of the normal force and the Coulomb force at the contact point, c_u d/dq + c_v d/dq_dot of
+    (F_a, F_v, F_w, T) by (u, v, w, theta_x), written into ``b``.  With t = (-n_w, n_v), the slip
+    s = (u_dot, t . (v_dot, w_dot) + R theta_x_dot), F = -M g(|s|) s, M = mu |F_n|, g of :func:`_slip_factor`:
+    dF = -dM g s - M (g I + gamma s s^T) ds, with d t / d(v, w) = (n_v n_w, -n_v^2; n_w^2, -n_v n_w) / r and
+    d s_t / d(v, w) = (n_w, -n_v) delta_dot / r."""
+    t_v, t_w = -n_w, n_v
+    s_a, s_t = du, t_v * dv + t_w * dw + arm * dtheta
+    g, gamma = _slip_factor(np.hypot(s_a, s_t), v_s)
+    magnitude = -mu * normal
+    f_t = -magnitude * g * s_t
+    j_aa, j_at, j_tt = g + gamma * s_a * s_a, gamma * s_a * s_t, g + gamma * s_t * s_t
+    turn = c_u / r
+    for j in range(4):
+        ds_a = c_v if j == 0 else 0.0
+        if j == 1:
+            ds_t, dfn = turn * n_w * d_rate + c_v * t_v, dfn_v
+            dn_v, dn_w = turn * n_w * n_w, -turn * n_v * n_w
+        elif j == 2:
+            ds_t, dfn = -turn * n_v * d_rate + c_v * t_w, dfn_w
+            dn_v, dn_w = -turn * n_v * n_w, turn * n_v * n_v
+        else:
+            ds_t, dfn, dn_v, dn_w = (c_v * arm if j == 3 else 0.0), 0.0, 0.0, 0.0
+        d_magnitude = -mu * dfn
+        df_a = -(d_magnitude * g * s_a + magnitude * (j_aa * ds_a + j_at * ds_t))
+        df_t = -(d_magnitude * g * s_t + magnitude * (j_at * ds_a + j_tt * ds_t))
+        b[0, j] = df_a
+        b[1, j] = dfn * n_v + normal * dn_v + df_t * t_v - f_t * dn_w
+        b[2, j] = dfn * n_w + normal * dn_w + df_t * t_w + f_t * dn_v
+        b[3, j] = arm * df_t
 
 
 @kernel
@@ -341,15 +428,15 @@ def _selection(rows: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
 
 
 class ProjectedLaws(Mapping):
-    """The generalised forces of the non-conservative wall laws (the damper of (17), (18), (19)), projected on
-    first use: the energy budget reads them at accepted steps only, not at Newton's iterates."""
+    """The generalised forces of the non-conservative wall laws (the damper of (17) and the two parts of friction:
+    axial and tangential for the Coulomb force, (18) and (19) for the paper's), projected on first use: the energy
+    budget reads them at accepted steps only, not at Newton's iterates."""
 
-    NAMES = ("wall_damper", "wall_axial_friction", "wall_friction_torque")
-
-    def __init__(self, vertex_set: "VertexSet", delta: np.ndarray, loads: np.ndarray):
+    def __init__(self, vertex_set: "VertexSet", delta: np.ndarray, loads: np.ndarray, names: tuple[str, ...]):
         """``vertex_set``: the vertices evaluated, with their rows; ``delta``, ``loads``: their indentations and the
-        loads of each law (vertex, field, law)."""
+        loads of each law (vertex, field, law), named ``names``."""
         self._rows, self._delta, self._loads, self._projected = vertex_set, delta, loads, None
+        self.NAMES = names
 
     def _laws(self) -> dict[str, np.ndarray]:
         if self._projected is None:
@@ -386,6 +473,7 @@ class WallForces(ForceEvaluation):
     delta: np.ndarray = None  # their indentations
     nodal: np.ndarray = None  # their loads (F_a, F_v, F_w, T)
     tangent_data: tuple | None = None  # what :meth:`WallContact.tangent` needs, if asked for
+    tangential_arm: float = 0.0  # with the Coulomb force: its torque's arm R_ext (T = R_ext F_t); 0: no lateral part
 
     @functools.cached_property
     def indentation(self) -> np.ndarray:
@@ -407,8 +495,13 @@ class WallForces(ForceEvaluation):
 
     @property
     def normal(self) -> np.ndarray:
-        """F_n (<= 0) at the vertices in contact."""
-        return -np.hypot(self._active[:, 1], self._active[:, 2])
+        """F_n (<= 0) at the vertices in contact: the lateral load less its friction part along the wall, which is
+        normal to it (|F_lateral|^2 = F_n^2 + F_t^2, F_t = T / R_ext)."""
+        lateral = np.hypot(self._active[:, 1], self._active[:, 2])
+        if not self.tangential_arm:
+            return -lateral
+        tangential = self._active[:, 3] / self.tangential_arm
+        return -np.sqrt(np.maximum(lateral**2 - tangential**2, 0.0))
 
     @property
     def axial(self) -> np.ndarray:
@@ -447,12 +540,18 @@ class WallContact:
 
     def __init__(self, disc: BeamDiscretization, space, contact, borehole_radius: float,
                  law_sign: tuple[float, float] = (1.0, 1.0), damper_law: str = "consistent", culling: bool = True):
-        """``contact``: the scene's [contact] section; ``law_sign``: +1 (consistent) or -1 (as printed) for
-        the axial friction (18) and the friction torque (19); ``damper_law``: the damper of (17);
-        ``culling``: evaluate the law only at the vertices that can reach the wall (exact)."""
+        """``contact``: the scene's [contact] section (its ``friction_model`` chooses the friction law);
+        ``law_sign``: +1 (consistent) or -1 (as printed) for the axial friction (18) and the friction torque (19)
+        of the paper's model; ``damper_law``: the damper of (17); ``culling``: evaluate the law only at the
+        vertices that can reach the wall (exact)."""
         self.x = disc.vertex_x
         self.gap = borehole_radius - disc.properties.outer_radius
         self.borehole_radius = borehole_radius
+        self.coulomb = contact.friction_model == "coulomb"
+        # the friction torque's arm: the pipe's surface, where the Coulomb force acts; the borehole's radius in (19)
+        self.arm = disc.properties.outer_radius if self.coulomb else borehole_radius
+        self.law_names = ("wall_damper", "wall_friction_axial", "wall_friction_tangential") if self.coulomb else \
+            ("wall_damper", "wall_axial_friction", "wall_friction_torque")
         self.k1, self.k2 = contact.stiffness_linear, contact.stiffness_cubic
         self.c = contact.damping
         self.damper_law = damper_law
@@ -507,7 +606,7 @@ class WallContact:
     def _law(self) -> tuple:
         """The law's constants, in the order the compiled kernels take them."""
         return (self.gap, self.k1, self.k2, self.c, self.damper_law == "printed", self.mu_axial, self.mu_torque,
-                self.borehole_radius, self.v_s)
+                self.arm, self.v_s, self.coulomb)
 
     #: Vertices within this share of the gap from the wall are evaluated; the others are left out until
     #: q has moved enough, by the bound of :meth:`_near_vertices`, to possibly bring one of them to it.
@@ -555,8 +654,9 @@ class WallContact:
         """The evaluation of the vertices ``vertex_set`` from what :func:`_modal_pass` gives for them (also what a
         compiled Newton step hands back: solvers/compiled_step.py)."""
         delta, nodal, laws, potential, generalised, lateral, rates = passed
-        by_law = ProjectedLaws(vertex_set, delta, laws)
-        out = WallForces(generalised, potential, by_law, len(self.x), vertex_set.vertices, delta, nodal)
+        by_law = ProjectedLaws(vertex_set, delta, laws, self.law_names)
+        out = WallForces(generalised, potential, by_law, len(self.x), vertex_set.vertices, delta, nodal,
+                         tangential_arm=self.arm if self.coulomb else 0.0)
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
             out.tangent_data = (vertex_set.flat, lateral, rates)
         return out

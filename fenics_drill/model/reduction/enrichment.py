@@ -85,15 +85,41 @@ def wall_rest_load(disc: BeamDiscretization, gravity: np.ndarray, gravity_respon
     return load
 
 
-def wall_friction_loads(disc: BeamDiscretization, reaction: np.ndarray) -> dict[str, np.ndarray]:
-    """The axial friction (18) and the friction torque (19) that the wall's ``reaction`` at rest (full-space loads
-    on v and w) drives: at each resting vertex |F_n| on u and on theta_x (a static response's shape depends neither on the friction
-    coefficients, nor on R_bh, nor on the direction of sliding)."""
-    magnitude = np.hypot(reaction[disc.vertex_dofs(V)], reaction[disc.vertex_dofs(W)])
+def wall_friction_loads(disc: BeamDiscretization, reaction: np.ndarray, lateral: bool = False) -> dict[str, np.ndarray]:
+    """The friction that the wall's ``reaction`` at rest (full-space loads on v and w) drives: at each resting vertex
+    |F_n| on u (the axial friction) and on theta_x (the friction torque), and with ``lateral`` (the Coulomb force
+    at the contact point) |F_n| along the wall's tangent t = (-n_w, n_v), which makes a spinning string climb.  A
+    static response's shape depends neither on the friction coefficient, nor on the torque's arm, nor on the
+    direction of sliding."""
+    on_v, on_w = reaction[disc.vertex_dofs(V)], reaction[disc.vertex_dofs(W)]
+    magnitude = np.hypot(on_v, on_w)
     axial, torque = np.zeros(disc.ndofs), np.zeros(disc.ndofs)
     axial[disc.vertex_dofs(U)] = magnitude
     torque[disc.vertex_dofs(THETA_X)] = magnitude
-    return {"wall_axial_friction": axial, "wall_friction_torque": torque}
+    loads = {"wall_axial_friction": axial, "wall_friction_torque": torque}
+    if lateral:  # the reaction is -|F_n| n: so |F_n| t = (reaction_w, -reaction_v)
+        along = np.zeros(disc.ndofs)
+        along[disc.vertex_dofs(V)], along[disc.vertex_dofs(W)] = on_w, -on_v
+        loads["wall_lateral_friction"] = along
+    return loads
+
+
+def climbing_friction(scene, disc: BeamDiscretization, operators: LinearOperators) -> str | None:
+    """Why no modal basis can carry the scene, or None: a spinning string that rests on the wall with Coulomb
+    friction at the contact point climbs it and swings along it, each resting vertex on the round wall, whose
+    second-order shape (w = -sqrt(gap^2 - v^2)) a linear subspace misses by more than the wall's indentation
+    (0.25 um on the paper's string) after a turn of half a degree: the reduced string lifted off and bounced
+    (2505 impacts in 2 s of the paper scene) where the full order rests (0; docs/verification.md)."""
+    contact = scene.contact
+    if not (scene.model.contact and scene.model.gravity and contact.friction_model == "coulomb"
+            and contact.friction > 0 and scene.drive.rotation_speed != 0 and np.any(operators.gravity)):
+        return None
+    statics = StaticSolver(disc, operators)
+    gap = scene.borehole.radius - scene.beam.outer_radius
+    if wall_rest_load(disc, operators.gravity, statics.responses(operators.gravity)[:, 0], gap) is None:
+        return None
+    return ("the spinning string rests on the wall with Coulomb friction at the contact point: it climbs and swings "
+            "along the round wall, which a modal basis cannot follow (contact.friction_model = 'coulomb')")
 
 
 def scene_loads(scene, disc: BeamDiscretization, operators: LinearOperators, statics: StaticSolver):
@@ -109,7 +135,7 @@ def scene_loads(scene, disc: BeamDiscretization, operators: LinearOperators, sta
         if wall is not None:
             loads["wall_at_rest"] = wall
             if scene.contact.friction > 0:
-                loads.update(wall_friction_loads(disc, wall))
+                loads.update(wall_friction_loads(disc, wall, scene.contact.friction_model == "coulomb"))
     return loads
 
 

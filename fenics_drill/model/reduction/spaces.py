@@ -23,7 +23,7 @@ from scipy.linalg.lapack import dgetrs as getrs
 
 from fenics_drill.model.kernels.banded_saddle import BandedSaddle
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
-from fenics_drill.model.reduction.enrichment import MODE_SPAN_TOLERANCE, augment, enrich
+from fenics_drill.model.reduction.enrichment import MODE_SPAN_TOLERANCE, augment, climbing_friction, enrich
 from fenics_drill.model.reduction.modes import reduction_bands, select_modes, solve_modes, stuck_bit_modes
 from fenics_drill.model.operators import LinearOperators
 
@@ -319,6 +319,11 @@ def solution_space(scene, disc: BeamDiscretization, operators: LinearOperators):
     modes = solve_modes(disc, scene.modal.f_star_max, operators.mass)
     if scene.reduction.rule == "none":
         return FullSpace(disc), None, modes, {}, None
+    if (why := climbing_friction(scene, disc, operators)) is not None:
+        if scene.reduction.rule == "auto":
+            return FullSpace(disc), None, modes, {"full_order": {"chosen": True, "why": why}}, None
+        raise BasisError(f"reduction.rule = '{scene.reduction.rule}' is not admissible here: {why}; use "
+                         "reduction.rule = 'auto' or 'none' (the full order), or contact.friction_model = 'paper'")
     basis = modes.select(select_modes(modes, scene))
     vectors, stuck = basis.vectors, None
     if scene.reduction.rule == "auto" and scene.model.bit_rock:
