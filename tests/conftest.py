@@ -10,9 +10,16 @@ from fenics_drill.scene import Scene, load_scene
 PAPER = Path(__file__).parents[1] / "demos" / "scenes" / "paper.toml"
 
 
+#: The paper's wall friction (18)-(19), with the regularisation the tests of the reduced model were set up with.
+#: Under the default Coulomb force at the contact point a spinning string on the wall climbs it and the 'auto'
+#: rule takes the full order (tests/model/test_coulomb_friction.py tests that law and that choice).
+PAPER_FRICTION = ("contact.friction_model='paper'", "contact.sliding_velocity_scale=1e-3")
+
+
 def scene_with(*overrides: str) -> Scene:
-    """The paper scene with ``section.key=value`` overrides applied."""
-    return load_scene(None, list(overrides))
+    """The paper scene with the paper's wall friction (:data:`PAPER_FRICTION`) and ``section.key=value``
+    overrides applied (which may choose the Coulomb force again)."""
+    return load_scene(None, [*PAPER_FRICTION, *overrides])
 
 
 @pytest.fixture

@@ -38,8 +38,8 @@ FIGURE_RECORD = "figures.json"
 #: What each command owns in its directory (glob patterns), and what marks a directory as its own
 #: when an older version wrote no ``command`` into ``summary.json``.
 OWNED = {
-    "run": ("summary.json", "timeseries.h5", "fields.xdmf", "fields.h5", "fig*.png", "spectra.json",
-            "animation.gif", FIGURE_RECORD),
+    "run": ("summary.json", "timeseries.h5", "fields.xdmf", "fields.h5", "fig*.png", "torque_drag.png",
+            "spectra.json", "animation.gif", FIGURE_RECORD),
     "static": ("summary.json", "static.json", "static.xdmf", "static.h5"),
     "modal": ("summary.json", "modes.json"),
     "campbell": ("summary.json", "campbell.json", "campbell.png", FIGURE_RECORD),

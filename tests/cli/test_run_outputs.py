@@ -43,7 +43,8 @@ def test_run_writes_summary_timeseries_and_fields(tmp_path):
     assert u[-1] - u[0] == pytest.approx(travel, rel=0.05)
     xdmf = (tmp_path / "fields.xdmf").read_text()
     with h5py.File(tmp_path / "fields.h5") as f:
-        assert set(f["Function"]) == {"u", "v", "w", "theta_x", "theta_y", "theta_z", "displacement", "von_mises"}
+        assert set(f["Function"]) == {"u", "v", "w", "theta_x", "theta_y", "theta_z", "displacement", "von_mises",
+                                      "axial_force", "torque", "wall_normal_force_per_length"}
         snapshots = list(f["Function/w"])
         assert len(snapshots) == 6  # t = 0, 0.01, ..., 0.05
         assert f["Function/w"][snapshots[0]].shape[0] == 11  # P1: one value per vertex

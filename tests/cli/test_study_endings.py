@@ -59,7 +59,10 @@ def stop_and_time(process: subprocess.Popen, signum=signal.SIGINT) -> tuple[floa
     return time.monotonic() - sent, err
 
 
-MC = ["mc", PAPER, *SMALL, "--set", "time.t_end=0.3", "--samples", "8", "--quiet"]
+#: A short study; the paper's wall friction keeps its realisations reduced and quick (these tests are about how a
+#: study ends, not about its physics).
+MC = ["mc", PAPER, *SMALL, "--set", "time.t_end=0.3", "--samples", "8", "--quiet", "--set",
+      "contact.friction_model='paper'", "--set", "contact.sliding_velocity_scale=1e-3"]
 
 
 @pytest.mark.parametrize("moment", ["during the set-up", "once two realisations are written"])

@@ -19,8 +19,8 @@ from fenics_drill.solvers.time_loop import Simulation
 MU = 0.25
 #: A 20 m string of the paper's pipe sags onto the wall between 9 and 13 m; no bit, so that the drive's
 #: force and torque balance the wall's friction (and the damping (38), computed exactly below).
-ON_THE_WALL = ("beam.length=20.0", "beam.elements=80", "model.bit_rock=false", f"contact.friction={MU}",
-               "output.field_interval=0")
+ON_THE_WALL = ("contact.friction_model='coulomb'", "contact.sliding_velocity_scale=1e-5", "beam.length=20.0",
+               "beam.elements=80", "model.bit_rock=false", f"contact.friction={MU}", "output.field_interval=0")
 
 
 def run(scene, t_end):
@@ -159,7 +159,8 @@ def test_a_pipe_rolling_on_the_wall_whirls_backward_at_r_ext_omega_over_r():
     orbit at -R_ext Omega / r, backward.  The centrifugal load of that whirl (53 rad/s, above the first bending
     frequency, 24 rad/s) keeps it on the wall, and friction keeps it rolling."""
     spin, radius = 10.0, 0.08
-    scene = scene_with("beam.length=10.0", "beam.elements=20", "model.supports='pinned'", "model.gravity=false",
+    scene = scene_with("contact.friction_model='coulomb'", "contact.sliding_velocity_scale=1e-5",
+                       "beam.length=10.0", "beam.elements=20", "model.supports='pinned'", "model.gravity=false",
                        "model.bit_rock=false", "drive.axial_velocity=0.0", f"drive.rotation_speed={spin}",
                        "contact.friction=0.3", "reduction.rule='none'", "output.field_interval=0")
     prepared = prepare(scene, dynamics=False)

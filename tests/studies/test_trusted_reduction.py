@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import PAPER
+from conftest import PAPER, PAPER_FRICTION
 
 from fenics_drill.model.discretization import THETA_X, U, W
 from fenics_drill.model.reduction.spaces import BasisError
@@ -22,7 +22,7 @@ FREE = ["borehole.radius=3.0", "model.bit_rock=false"]
 
 
 def string(length, elements, *extra):
-    scene = load_scene(PAPER, [f"beam.length={length}", f"beam.elements={elements}", *FREE, *extra])
+    scene = load_scene(PAPER, [*PAPER_FRICTION, f"beam.length={length}", f"beam.elements={elements}", *FREE, *extra])
     prepared = prepare(scene)
     model = prepared.model
     dofs = model.space.expand(prepared.equilibrium.q)
@@ -132,7 +132,7 @@ def test_the_full_order_sag_at_large_deflection_converges_with_the_mesh():
 
 def test_tip_compliance_under_the_bit_loads_is_exact_with_the_default_basis():
     """u(L) = F L / (E A) and theta_x(L) = T L / (2 kappa_s G I4) with the drive end held (Eqs. 44, 46)."""
-    scene = load_scene(PAPER, ["model.gravity=false", "model.contact=false", "model.geometric_nonlinearity=false",
+    scene = load_scene(PAPER, [*PAPER_FRICTION, "model.gravity=false", "model.contact=false", "model.geometric_nonlinearity=false",
                                "model.inertial_nonlinearity=false"])
     from fenics_drill.model.drillstring import build_model
     from fenics_drill.model.operators import assemble_linear
@@ -158,7 +158,7 @@ def test_the_held_top_carries_the_whole_wall_friction_of_a_resting_string_with_t
     bar held at x = 0, free at the bit, nodal loads: the FE strain of the first element is exact).  The band's
     axial modes miss 28 % of that static response and half of the strain at the top, where the peak stress
     sits; the guard finds it and the enrichment adds it (fenics_drill/model/reduction/enrichment.py)."""
-    scene = load_scene(PAPER, ["model.geometric_nonlinearity=false", "model.inertial_nonlinearity=false"])
+    scene = load_scene(PAPER, [*PAPER_FRICTION, "model.geometric_nonlinearity=false", "model.inertial_nonlinearity=false"])
     from fenics_drill.model.drillstring import build_model
     from fenics_drill.model.reduction.enrichment import StaticSolver, wall_friction_loads, wall_rest_load
     from fenics_drill.model.operators import assemble_linear
@@ -202,7 +202,7 @@ def bit_motion(length, elements, *extra):
     """rop, mean and RMS of the bit velocity [m/s] and RMS of the bit spin [rad/s] of a short drilling run."""
     from fenics_drill.solvers.time_loop import Simulation
 
-    scene = load_scene(PAPER, [f"beam.length={length}", f"beam.elements={elements}", "time.t_end=0.2",
+    scene = load_scene(PAPER, [*PAPER_FRICTION, f"beam.length={length}", f"beam.elements={elements}", "time.t_end=0.2",
                                "output.field_interval=0", *extra])
     prepared = prepare(scene)
     simulation = Simulation(prepared.model, scene)
@@ -252,7 +252,7 @@ def test_the_basis_damps_its_directions_above_the_band_and_nothing_else():
     from fenics_drill.model.resolution import band_frequency
     from fenics_drill.model.reduction.out_of_band_damping import OUT_OF_BAND_FACTOR
 
-    scene = load_scene(PAPER, [*STICKING, "reduction.out_of_band_damping=0.7"])
+    scene = load_scene(PAPER, [*PAPER_FRICTION, *STICKING, "reduction.out_of_band_damping=0.7"])
     prepared = prepare(scene, dynamics=False)
     model = prepared.model
     damping = model.force("out_of_band").damping
@@ -280,7 +280,7 @@ def test_a_reduced_bit_in_stick_slip_does_not_ring_and_matches_the_full_order(tm
     bit's spin varies about as much as the full order's (ratio 0.96 against 0.89; 105 undamped)."""
     from fenics_drill.studies.run import run_scene
 
-    runs = {rule: run_scene(load_scene(PAPER, [*STICKING, "time.t_end=0.8", f"reduction.rule='{rule}'"]),
+    runs = {rule: run_scene(load_scene(PAPER, [*PAPER_FRICTION, *STICKING, "time.t_end=0.8", f"reduction.rule='{rule}'"]),
                             tmp_path / rule, progress=False) for rule in ("auto", "none")}
     reduced, full = runs["auto"], runs["none"]
     assert reduced["max_von_mises"]["value"] == pytest.approx(full["max_von_mises"]["value"], rel=0.01)
@@ -305,7 +305,7 @@ def test_a_pinned_string_resting_on_the_wall_takes_the_weight_on_bit_as_its_full
     base = ["beam.length=40", "beam.elements=100", "model.supports='pinned'"]
 
     def peak_stress(*extra):
-        scene = load_scene(PAPER, [*base, *extra])
+        scene = load_scene(PAPER, [*PAPER_FRICTION, *base, *extra])
         prepared = prepare(scene, dynamics=False)
         pushed = prepared.model.with_added_force(AxialTipLoad(prepared.model.disc, prepared.model.space, 30e3))
         equilibrium = solve_static(pushed, initial=prepared.equilibrium.q)
@@ -338,12 +338,12 @@ def test_a_stabilised_thin_string_rests_on_the_wall_as_its_full_order_does(tmp_p
     full order's (the reduced contact still flickers at a few vertices: its peak stress is 2.9 % low here)."""
     from fenics_drill.studies.run import run_scene
 
-    runs = {rule: run_scene(load_scene(PAPER, [*STABILISED, f"reduction.rule='{rule}'"]), tmp_path / rule,
+    runs = {rule: run_scene(load_scene(PAPER, [*PAPER_FRICTION, *STABILISED, f"reduction.rule='{rule}'"]), tmp_path / rule,
                             progress=False) for rule in ("auto", "none")}
     reduced, full = runs["auto"], runs["none"]
     assert reduced["impacts_total"] <= full["impacts_total"] + 5
     assert reduced["rop"] == pytest.approx(full["rop"], rel=0.005)
     assert reduced["efficiency"] == pytest.approx(full["efficiency"], rel=0.005)
-    damped = prepare(load_scene(PAPER, STABILISED), dynamics=False).model.force("out_of_band").frequencies_hz
-    free = prepare(load_scene(PAPER, [*STABILISED, "model.contact=false"]), dynamics=False).model
+    damped = prepare(load_scene(PAPER, [*PAPER_FRICTION, *STABILISED]), dynamics=False).model.force("out_of_band").frequencies_hz
+    free = prepare(load_scene(PAPER, [*PAPER_FRICTION, *STABILISED, "model.contact=false"]), dynamics=False).model
     assert len(damped) > len(free.force("out_of_band").frequencies_hz)  # the wall's springs raised some above the cut
