@@ -17,9 +17,11 @@ demo: setup
 	$(PY) -m fenics_drill.cli modal demos/scenes/paper.toml --overwrite --out $(OUT)/paper
 	$(PY) demos/modal_distributions.py --out $(OUT)/modal-distributions
 
-## The paper's kinematics (14) as printed: the run that reproduces its shock packages (docs/verification.md).
+## The paper's kinematics (14) as printed, with its friction laws (18)-(19): the reduced run that reproduces its
+## shock packages (docs/reproduction.md).
 demo-printed: setup
-	$(PY) -m fenics_drill.cli run demos/scenes/paper.toml --set time.t_end=$(T_END) --set model.kinematics=printed --overwrite --out $(OUT)/nominal-printed
+	$(PY) -m fenics_drill.cli run demos/scenes/paper.toml --set time.t_end=$(T_END) --set model.kinematics=printed \
+		--set contact.friction_model=paper --set contact.sliding_velocity_scale=1e-3 --overwrite --out $(OUT)/nominal-printed
 	$(PY) -m fenics_drill.cli plot $(OUT)/nominal-printed
 
 ## Every law as printed (kinematics (14), friction (18)-(19), bit torque (21)): the paper's Figs. 14-23 as
@@ -36,7 +38,7 @@ demo-as-printed: setup
 reproduction: setup
 	$(PY) benchmarks/reproduction.py --ranks $(RANKS)
 
-## The test suite (about 8 minutes on 2 cores).
+## The test suite (about 12 minutes on 2 cores).
 test: setup
 	$(PY) -m pytest -q tests
 
@@ -69,8 +71,8 @@ campbell: setup
 	$(PY) -m fenics_drill.cli campbell demos/scenes/campbell_paper.toml --set campbell.weight_on_bit=true \
 		--overwrite --out $(OUT)/campbell-wob
 
-## The paper's Monte Carlo study (Section 6.11) at SAMPLES realisations on RANKS processes (about 14 s per
-## realisation of 10 s on each of 2 ranks here: the paper's 1024 in about 2.0 h).
+## The paper's Monte Carlo study (Section 6.11) at SAMPLES realisations on RANKS processes (with the default Coulomb
+## friction each realisation of 10 s runs the full order, about 160 s on one core here).
 SAMPLES ?= 32
 RANKS ?= 2
 mc: setup

@@ -147,7 +147,8 @@ def _file_size_limit(limit: int):
 def test_a_full_disk_fails_a_run_in_one_line_with_a_final_summary(tmp_path):
     out = tmp_path / "run"
     # 6 MB: MPI's own shared-memory files (4.3 MB) must still fit, the time series of 5 s (9 MB) does not
-    result = subprocess.run([*TOOL, "run", PAPER, *SMALL, "--set", "time.t_end=5", "--quiet", "--out", str(out)],
+    result = subprocess.run([*TOOL, "run", PAPER, *SMALL, "--set", "time.t_end=5", "--set",
+                             "contact.friction_model='paper'", "--quiet", "--out", str(out)],  # reduced: quick
                             capture_output=True, text=True, cwd=ROOT, timeout=TIMEOUT,
                             preexec_fn=_file_size_limit(6_000_000))
     assert result.returncode == 1
