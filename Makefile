@@ -2,7 +2,7 @@
 PY := .venv/bin/python
 OUT ?= out
 
-.PHONY: setup docs demo demo-printed demo-as-printed reproduction test bench bench-ross campbell mc optimize stick-slip clean
+.PHONY: setup docs demo demo-printed demo-as-printed reproduction test bench bench-ross campbell wells mc optimize stick-slip clean
 
 setup:
 	@bash scripts/bootstrap.sh
@@ -70,6 +70,14 @@ campbell: setup
 	$(PY) -m fenics_drill.cli campbell demos/scenes/campbell_paper.toml --overwrite --out $(OUT)/campbell
 	$(PY) -m fenics_drill.cli campbell demos/scenes/campbell_paper.toml --set campbell.weight_on_bit=true \
 		--overwrite --out $(OUT)/campbell-wob
+
+## The two demo wells (docs/wells.md): soft-string torque and drag, buckling, figures; the manual's copies of the
+## figures and the convergence-and-cost table (benchmarks/results/torque_drag_wells.md).  A few seconds each.
+wells: setup
+	$(PY) -m fenics_drill.cli torque-drag demos/scenes/well_vbh.toml --overwrite --out $(OUT)/well-vbh
+	$(PY) -m fenics_drill.cli torque-drag demos/scenes/well_3d.toml --overwrite --out $(OUT)/well-3d
+	for w in vbh 3d; do for f in well_loads well_path well_3d; do cp $(OUT)/well-$$w/$$f.png docs/figures/$${f}_$$w.png; done; done
+	$(PY) benchmarks/torque_drag_wells.py
 
 ## The paper's Monte Carlo study (Section 6.11) at SAMPLES realisations on RANKS processes (with the default Coulomb
 ## friction each realisation of 10 s runs the full order, about 160 s on one core here).

@@ -42,7 +42,8 @@ from fenics_drill.scene import Scene, SceneError, load_scene  # noqa: E402
 __version__ = "0.2.0"
 
 #: The API functions, imported on first use (``fenics-drill scene`` needs none of DOLFINx).
-_API = ("RunResult", "modal_analysis", "static_state", "run", "monte_carlo", "operating_window", "campbell", "plot")
+_API = ("RunResult", "modal_analysis", "static_state", "run", "monte_carlo", "operating_window", "campbell", "TorqueDragResult",
+        "torque_drag", "plot")
 
 __all__ = ["Scene", "SceneError", "load_scene", *_API]
 

@@ -8,6 +8,7 @@
     mc = fd.monte_carlo(scene, samples=8, out="out/mc")
     window = fd.operating_window(scene, out="out/window")
     diagram = fd.campbell(scene)                # campbell.json as a dict (critical speeds, whirl)
+    td = fd.torque_drag(fd.load_scene("demos/scenes/well_vbh.toml"))  # td.report (dict), td.profiles (xarray)
 
 Every call takes a :class:`~fenics_drill.scene.Scene`; change one with
 ``scene.with_changes(drive={"rotation_speed": 5.0})``.  The command line does the same
@@ -29,6 +30,7 @@ from fenics_drill.studies.monte_carlo import monte_carlo as _monte_carlo
 from fenics_drill.studies.operating_window import run_optimize
 from fenics_drill.studies.prepare import prepare
 from fenics_drill.studies.run import run_scene, run_static
+from fenics_drill.studies.torque_drag import torque_drag_study, write_torque_drag
 
 
 @dataclass(frozen=True)
@@ -84,6 +86,23 @@ def campbell(scene: Scene, out: str | Path | None = None, overwrite: bool = Fals
     return campbell_report(scene)
 
 
+@dataclass(frozen=True)
+class TorqueDragResult:
+    """A soft-string study: ``report`` (torque_drag.json as a dict) and ``profiles`` (an ``xarray.Dataset`` over
+    measured depth: tension, torque and wall force per operation, the buckling loads, the path)."""
+
+    report: dict
+    profiles: object
+
+
+def torque_drag(scene: Scene, out: str | Path | None = None, overwrite: bool = False) -> TorqueDragResult:
+    """Soft-string torque and drag along the scene's well for each of ``torque_drag.operations``; with ``out``
+    also written there (torque_drag.json, torque_drag.h5, well.vtu; draw it with :func:`plot`)."""
+    study = write_torque_drag(scene, out, overwrite=overwrite) if out is not None else torque_drag_study(scene)
+    return TorqueDragResult(study["report"], study["profiles"])
+
+
 def plot(directory: str | Path, gif: bool = False) -> list[Path]:
-    """The figures of a run, Monte Carlo study, operating window or Campbell directory; returns the files."""
+    """The figures of a run, Monte Carlo study, operating window, Campbell or torque-and-drag directory; returns
+    the files."""
     return plot_directory(Path(directory), gif=gif)

@@ -200,6 +200,28 @@ def cmd_forms(args) -> int:
     return 0
 
 
+def cmd_torque_drag(args) -> int:
+    """Soft-string torque and drag along the scene's well: DIR/torque_drag.json, torque_drag.h5, well.vtu, figures."""
+    from fenics_drill.plots.directory import plot_directory
+    from fenics_drill.studies.torque_drag import write_torque_drag
+
+    scene = load_scene(args.scene, args.overrides)
+    report = write_torque_drag(scene, args.out, overwrite=args.overwrite)["report"]
+    plot_directory(Path(args.out))
+    well = report["well"]
+    print(f"{well['measured_depth_m']:.0f} m well (TVD {well['true_vertical_depth_m']:.0f} m, max dogleg "
+          f"{well['max_dogleg_deg_per_30m']:.2f} deg/30 m), {report['string']['length_m']:.0f} m string, "
+          f"{report['elements']} elements [{report['wall_time_s']:.2f} s] -> {Path(args.out) / 'torque_drag.json'}")
+    for name, op in report["operations"].items():
+        buckled = (f", buckled from md {op['first_buckled_md_m']:.0f} m (sinusoidal "
+                   f"{op['sinusoidally_buckled_length_m']:.0f} m, helical {op['helically_buckled_length_m']:.0f} m)"
+                   if op["first_buckled_md_m"] is not None else "")
+        locked = ", LOCKED UP: the surface would have to push" if op["locked_up"] else ""
+        print(f"  {name:<20s} hook load {op['hook_load_N'] / 1e3:9.1f} kN, surface torque "
+              f"{op['surface_torque_Nm'] / 1e3:7.2f} kN m{buckled}{locked}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="fenics-drill",
@@ -236,6 +258,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true", help="continue in --out, skipping the points done")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_optimize)
+    p = sub.add_parser("torque-drag", help="soft-string torque and drag along the scene's well (survey, string "
+                                           "sections, mud): DIR/torque_drag.json, torque_drag.h5, well.vtu")
+    _scene_args(p)
+    p.set_defaults(func=cmd_torque_drag)
     p = sub.add_parser("plot", help="figures of a run (Figs. 13-23, spectra.json, animation.gif), a Monte Carlo "
                                     "study (Figs. 28-35), an operating window or a Campbell diagram")
     p.add_argument("run_dir", help="the --out directory of 'fenics-drill run', 'mc', 'optimize' or 'campbell'")

@@ -304,6 +304,116 @@ class Campbell:
     damping: bool = key(False, "include the dissipation (38): damped frequencies and damping ratios")
 
 
+def _numbers(x) -> bool:
+    return _positions(x)
+
+
+@dataclass(frozen=True)
+class Well:
+    """The well from its survey (minimum curvature) and its hole sections; absent, the straight horizontal hole
+    of ``beam.length`` and ``borehole.radius``."""
+
+    survey: str = key("", "survey CSV file (columns md, inclination, azimuth), relative to the scene file")
+    md: tuple = key((), "measured depths of the survey stations, inline instead of a file [m]", _numbers,
+                    "a list of numbers")
+    inclination: tuple = key((), "inclination of each station from the vertical [deg]", _numbers, "a list of numbers")
+    azimuth: tuple = key((), "azimuth of each station, clockwise from north [deg]", _numbers, "a list of numbers")
+    hole_bottom: tuple = key((), "measured depth of the bottom of each hole section, increasing [m]", _numbers,
+                             "a list of numbers")
+    hole_radius: tuple = key((), "radius of each hole section [m]", _numbers, "a list of numbers")
+    hole_cased: tuple = key((), "whether each hole section is cased (true) or open hole (false)",
+                            lambda x: all(isinstance(v, bool) for v in x), "a list of true or false")
+
+
+#: The keys of a string section (a table of ``string.sections``), with their meaning and unit.
+SECTION_KEYS = {
+    "name": "what the section is (drill pipe, heavy-weight, collar, stabiliser, ...)",
+    "length": "length of the section [m]",
+    "outer_radius": "outer radius of the pipe body [m]",
+    "inner_radius": "inner radius [m]",
+    "density": "steel density [kg/m^3] (default beam.density)",
+    "young_modulus": "elastic modulus [Pa] (default beam.young_modulus)",
+    "poisson_ratio": "Poisson ratio [-] (default beam.poisson_ratio)",
+    "tool_joint_outer_radius": "outer radius of the tool joints, the contact radius where they touch the wall [m] "
+                               "(0: none)",
+    "tool_joint_length": "length of one tool joint [m]",
+    "tool_joint_spacing": "distance between tool joints, one joint of pipe [m]",
+}
+
+
+def _string_sections(sections) -> bool:
+    """Each section a table of SECTION_KEYS with positive lengths and radii; raises SceneError naming the section
+    and the key."""
+    for k, section in enumerate(sections, start=1):
+        where = f"string.sections[{k}]"
+        if not isinstance(section, dict):
+            raise SceneError(f"{where} = {section!r} is not admissible: each section is a table of keys "
+                             f"({', '.join(SECTION_KEYS)})")
+        unknown = [name for name in section if name not in SECTION_KEYS]
+        if unknown:
+            raise SceneError(f"unknown key {where}.{unknown[0]}; known keys: {', '.join(SECTION_KEYS)}")
+        for name in ("length", "outer_radius", "inner_radius"):
+            if name not in section:
+                raise SceneError(f"{where} has no {name}: give {SECTION_KEYS[name]}")
+        for name, value in section.items():
+            if name == "name":
+                continue
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+                raise SceneError(f"{where}.{name} = {value!r} is not admissible: must be a number >= 0")
+        if section["length"] <= 0 or section["outer_radius"] <= 0:
+            raise SceneError(f"{where}: length and outer_radius must be > 0")
+        if section["inner_radius"] >= section["outer_radius"]:
+            raise SceneError(f"{where}.inner_radius = {section['inner_radius']!r} is not admissible: must be < "
+                             f"outer_radius = {section['outer_radius']!r}")
+        joint = section.get("tool_joint_outer_radius", 0.0)
+        if joint and joint < section["outer_radius"]:
+            raise SceneError(f"{where}.tool_joint_outer_radius = {joint!r} is not admissible: must be >= "
+                             f"outer_radius = {section['outer_radius']!r} (or 0 for none)")
+        if joint and not (section.get("tool_joint_length", 0) > 0 and section.get("tool_joint_spacing", 0) > 0):
+            raise SceneError(f"{where}: a tool joint needs tool_joint_length > 0 and tool_joint_spacing > 0")
+    return True
+
+
+@dataclass(frozen=True)
+class String:
+    """The drillstring from the bit up; absent, the one pipe of [beam]."""
+
+    sections: tuple = key((), "the string's sections from the bit up: tables of name, length, outer_radius, "
+                          "inner_radius, ...", _string_sections, "a list of tables")
+
+
+@dataclass(frozen=True)
+class Fluid:
+    """The drilling fluid: buoyancy of the string (inside and outside); in the FE model also the lateral added
+    mass and a viscous lateral damping."""
+
+    density: float = _nonneg("density of the mud in the annulus, 0 for air [kg/m^3]", 0.0)
+    inner_density: float = key(-1.0, "density of the fluid inside the pipe, -1 for the mud's [kg/m^3]",
+                               lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for fluid.density)")
+    added_mass_coefficient: float = key(-1.0, "lateral added mass of the mud over rho_m pi R^2, -1 for the annulus' "
+                                        "[-]", lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for the confined annulus)")
+    lateral_damping: float = _nonneg("the mud's viscous force per length and lateral velocity [N s/m^2]", 0.0)
+
+
+_OPERATIONS = ("rotating_on_bottom", "rotating_off_bottom", "sliding", "tripping_in", "tripping_out")
+
+
+@dataclass(frozen=True)
+class TorqueDrag:
+    """The soft-string torque-and-drag study (``fenics-drill torque-drag``)."""
+
+    operations: tuple = key(_OPERATIONS, "operations to compute", lambda x: all(o in _OPERATIONS for o in x),
+                            " and ".join(_OPERATIONS))
+    friction_cased: float = _nonneg("friction coefficient in cased hole [-]", 0.25)
+    friction_open: float = _nonneg("friction coefficient in open hole [-]", 0.30)
+    weight_on_bit: float = _nonneg("weight on bit while drilling [N]", 50e3)
+    torque_on_bit: float = _nonneg("torque on bit while drilling on bottom [N m]", 5e3)
+    rotation_speed: float = _nonneg("rotation speed while rotating [rad/s]", 2.0 * math.pi)
+    trip_speed: float = _pos("axial speed while tripping [m/s]", 0.3)
+    rate_of_penetration: float = _nonneg("axial speed while drilling [m/s]", 20.0 / 3600.0)
+    element_length: float = _pos("length of the soft string's elements [m]", 10.0)
+
+
 @dataclass(frozen=True)
 class Scene:
     """A validated scene: one typed, immutable section per TOML table."""
@@ -324,6 +434,10 @@ class Scene:
     uncertainty: Uncertainty = field(default_factory=Uncertainty)
     optimize: Optimize = field(default_factory=Optimize)
     campbell: Campbell = field(default_factory=Campbell)
+    well: Well = field(default_factory=Well)
+    string: String = field(default_factory=String)
+    fluid: Fluid = field(default_factory=Fluid)
+    torque_drag: TorqueDrag = field(default_factory=TorqueDrag)
 
     def to_dict(self) -> dict[str, dict[str, Any]]:
         """The scene as nested plain values (what summary files and study directories store)."""
@@ -347,8 +461,32 @@ class Scene:
         return BeamProperties(
             length=b.length, outer_radius=b.outer_radius, inner_radius=b.inner_radius, density=b.density,
             young_modulus=b.young_modulus, poisson_ratio=b.poisson_ratio, shear_factor=b.shear_factor,
-            damping=b.damping, gravity=self.environment.gravity if self.model.gravity else 0.0,
+            damping=b.damping, gravity=self.environment.gravity * self.buoyancy_factor if self.model.gravity else 0.0,
+            lateral_added_mass=self.lateral_added_mass, lateral_fluid_damping=self.fluid.lateral_damping,
         )
+
+    def _inner_fluid_density(self) -> float:
+        return self.fluid.density if self.fluid.inner_density == -1.0 else self.fluid.inner_density
+
+    @property
+    def lateral_added_mass(self) -> float:
+        """The fluids' mass per length that moves with the pipe's lateral motion [kg/m]: the fluid inside,
+        rho_i pi r^2, and the mud outside, C_a rho_m pi R^2, with C_a = (R_h^2 + R^2) / (R_h^2 - R^2) of a
+        cylinder in a concentric annulus of radius R_h (potential flow; Chen, Wambsganss & Jendrzejczyk 1976)
+        unless ``fluid.added_mass_coefficient`` gives it."""
+        b, fluid = self.beam, self.fluid
+        hole2, pipe2 = self.borehole.radius**2, b.outer_radius**2
+        c_a = (hole2 + pipe2) / (hole2 - pipe2) if fluid.added_mass_coefficient == -1.0 else fluid.added_mass_coefficient
+        return math.pi * (self._inner_fluid_density() * b.inner_radius**2 + c_a * fluid.density * pipe2)
+
+    @property
+    def buoyancy_factor(self) -> float:
+        """The pipe's weight in the fluids over its weight in air: 1 + (rho_i A_i - rho_o A_o) / (rho_s A) (Archimedes
+        on the fluid outside and inside; 1 in air).  The FE model's gravity load (52) is scaled by it."""
+        b = self.beam
+        steel = b.outer_radius**2 - b.inner_radius**2
+        return 1.0 + (self._inner_fluid_density() * b.inner_radius**2 - self.fluid.density * b.outer_radius**2) / (
+            b.density * steel)
 
 
 #: The printed laws (18), (19), (21) are the consistent ones with mu replaced by -mu, since F_n, F_BR <= 0
@@ -554,6 +692,9 @@ def load_scene(path: str | Path | None = None, overrides: list[str] | tuple[str,
     raw: dict[str, Any] = {}
     if path is not None:
         raw = _read_toml(Path(path))
+        survey = raw.get("well", {}).get("survey") if isinstance(raw.get("well"), dict) else None
+        if isinstance(survey, str) and survey and not Path(survey).is_absolute():
+            raw["well"]["survey"] = str(Path(path).resolve().parent / survey)  # relative to the scene file
     for text in overrides:
         section, name, value = parse_override(text)
         raw.setdefault(section, {})

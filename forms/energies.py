@@ -118,15 +118,16 @@ def kinetic_energy_density(p: BeamProperties, U, V, inertial_nonlinearity: bool 
     w1, w2, w3 = angular_velocity(U, V, inertial_nonlinearity, angular_velocity_form)
     translational = 0.5 * p.density * s.area * (V[0] ** 2 + V[1] ** 2 + V[2] ** 2)
     rotational = 0.5 * p.density * s.I4 * (2.0 * w1**2 + w2**2 + w3**2)
-    return translational + rotational
+    fluid = 0.5 * p.lateral_added_mass * (V[1] ** 2 + V[2] ** 2)
+    return translational + rotational + fluid
 
 
 def dissipation_density(p: BeamProperties, V):
-    """Dissipation function per unit length, Eq. (38)."""
+    """Dissipation function per unit length, Eq. (38), plus the fluid's lateral viscous damping."""
     s = p.section
     return 0.5 * p.damping * p.density * (
         s.area * (V[0] ** 2 + V[1] ** 2 + V[2] ** 2) + s.I4 * (2.0 * V[3] ** 2 + V[4] ** 2 + V[5] ** 2)
-    )
+    ) + 0.5 * p.lateral_fluid_damping * (V[1] ** 2 + V[2] ** 2)
 
 
 def inertial_force(p: BeamProperties, psi, U, V, A, dx, inertial_nonlinearity: bool = True,

@@ -21,14 +21,19 @@ def _inertia_pairing(p: BeamProperties, psi, U):
     return rho * s.area * translational + rho * s.I4 * rotational
 
 
+def _lateral_pairing(psi, U):
+    return psi[1] * U[1] + psi[2] * U[2]
+
+
 def mass_form(p: BeamProperties, psi, U, dx):
-    """Mass operator M(psi, U), Eq. (44)."""
-    return _inertia_pairing(p, psi, U) * dx
+    """Mass operator M(psi, U), Eq. (44), with the fluid's lateral added mass m_f (v, w)."""
+    return (_inertia_pairing(p, psi, U) + p.lateral_added_mass * _lateral_pairing(psi, U)) * dx
 
 
 def damping_form(p: BeamProperties, psi, U, dx):
-    """Damping operator C(psi, U) = c M(psi, U), Eq. (45), from the dissipation function (38)."""
-    return p.damping * _inertia_pairing(p, psi, U) * dx
+    """Damping operator C(psi, U) = c M(psi, U), Eq. (45), from the dissipation function (38) (the steel's
+    inertia), plus the fluid's lateral viscous damping c_f (v, w)."""
+    return (p.damping * _inertia_pairing(p, psi, U) + p.lateral_fluid_damping * _lateral_pairing(psi, U)) * dx
 
 
 def stiffness_form(p: BeamProperties, psi, U, dx):

@@ -35,7 +35,9 @@ class BeamProperties:
 
     density rho [kg/m^3], young_modulus E [Pa], poisson_ratio nu [-],
     shear_factor kappa_s [-], damping c [1/s] (the paper's "dimensionless"
-    constant of Eq. 38 multiplies rho, so it carries 1/s), gravity g [m/s^2].
+    constant of Eq. 38 multiplies rho, so it carries 1/s), gravity g [m/s^2] (the weight per length
+    rho A g; in a fluid, reduced by its buoyancy); the fluid's lateral added mass m_f [kg/m] and
+    viscous damping c_f [N s/m^2] act on the lateral translations v, w only (0 in air).
     """
 
     length: float
@@ -47,6 +49,8 @@ class BeamProperties:
     shear_factor: float
     damping: float
     gravity: float
+    lateral_added_mass: float = 0.0  # fluid moving with the lateral motion (v, w) [kg/m]
+    lateral_fluid_damping: float = 0.0  # viscous force per length and lateral velocity [N s/m^2]
 
     @property
     def section(self) -> SectionConstants:

@@ -56,7 +56,7 @@ fig.tight_layout()
 # The string climbs the wall while it spins
 # -----------------------------------------
 # The tangential friction pushes the string up the wall until gravity's share along it balances mu N:
-# tan(phi) = mu s_t / |s|.  Without spin it stays at the bottom.
+# ``tan(phi) = mu s_t / |s|``.  Without spin it stays at the bottom.
 
 fig, ax = plt.subplots(figsize=(7, 3.2))
 for spin, (t, angle) in zip(speeds, angles):

@@ -46,11 +46,15 @@ OWNED = {
     "mc": ("summary.json", "scene.json", "nominal.h5", "nominal.h5.corrupt", "realisations", "statistics.h5", "fig*.png",
            FIGURE_RECORD),
     "optimize": ("summary.json", "scene.json", "points", "optimize.json", "fig*.png", FIGURE_RECORD),
+    "torque-drag": ("summary.json", "torque_drag.json", "torque_drag.h5", "well.vtu", "well_loads.png",
+                    "well_path.png", "well_3d.png", FIGURE_RECORD),
 }
 SIGNATURE = {"run": "timeseries.h5", "static": "static.json", "modal": "modes.json", "campbell": "campbell.json",
-             "mc": "realisations", "optimize": "points"}
+             "mc": "realisations", "optimize": "points",
+             "torque-drag": "torque_drag.json"}
 DESCRIPTION = {"run": "a drilling run", "static": "a static equilibrium", "modal": "a modal analysis",
-               "campbell": "a Campbell diagram", "mc": "a Monte Carlo study", "optimize": "an operating-window study"}
+               "campbell": "a Campbell diagram", "mc": "a Monte Carlo study", "optimize": "an operating-window study",
+               "torque-drag": "a torque-and-drag study"}
 
 
 class OutputError(ValueError):

@@ -5,7 +5,9 @@ Three concerns, from the bottom up (``tests/test_architecture.py`` holds them to
 
 - :mod:`~fenics_drill.model.kernels`: compiled numerics (Numba, FFCx's element kernels, banded solves);
 - the string's physics, in this package: discretisation and supports, linear operators, internal force,
-  the point forces (:mod:`~fenics_drill.model.forces`), the top drive and memory estimates;
+  the point forces (:mod:`~fenics_drill.model.forces`), the top drive and memory estimates; the well from its
+  survey (:mod:`~fenics_drill.model.well`), the string's sections (:mod:`~fenics_drill.model.string_sections`) and
+  the soft-string torque-and-drag model on them (:mod:`~fenics_drill.model.soft_string`);
 - :mod:`~fenics_drill.model.reduction`: modes, solution spaces, the basis guard, hyper-reduction;
 
 and on top of them :mod:`~fenics_drill.model.drillstring` (the assembled model: residual, tangent, drive

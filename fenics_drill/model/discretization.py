@@ -22,6 +22,7 @@ from mpi4py import MPI
 
 from fenics_drill.forms import FIELD_NAMES, BeamProperties
 from fenics_drill.model.resources import check_memory
+from fenics_drill.scene import SceneError
 
 #: Index of each field in the mixed space, in the paper's order (the one place they are declared).
 U, V, W, THETA_X, THETA_Y, THETA_Z = range(6)
@@ -64,7 +65,15 @@ class BeamDiscretization:
     @classmethod
     def from_scene(cls, scene) -> "BeamDiscretization":
         """The discretization a scene asks for (``beam.*``, ``model.supports``); refused before any
-        allocation if it does not fit in memory (:mod:`fenics_drill.model.resources`)."""
+        allocation if it does not fit in memory (:mod:`fenics_drill.model.resources`).  The beam lies in the
+        straight horizontal hole of ``beam.length`` and ``borehole.radius``: a scene that gives a survey or string
+        sections is refused (those are read by the soft-string model, ``fenics-drill torque-drag``)."""
+        given = [name for name, value in (("well.survey", scene.well.survey), ("well.md", scene.well.md),
+                                          ("well.hole_radius", scene.well.hole_radius), ("string.sections", scene.string.sections)) if value]
+        if given:
+            raise SceneError(f"{' and '.join(given)} describe a well for 'fenics-drill torque-drag' (the soft-string "
+                             "model); the finite-element model runs the straight horizontal hole of [beam] and "
+                             "[borehole]: leave them out for run, static, modal, campbell, mc and optimize")
         check_memory(scene.beam.elements, scene.beam.element_degree)
         return cls(scene.beam_properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports,
                    scene.supports.stabilisers)

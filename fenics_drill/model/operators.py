@@ -37,7 +37,7 @@ def _forms(disc: BeamDiscretization):
     p = disc.properties
     return (
         fem.form(mass_form(p, psi, U, dx)),
-        fem.form(damping_form(p, psi, U, dx)) if p.damping != 0 else None,  # c = 0: UFL's zero form
+        fem.form(damping_form(p, psi, U, dx)) if p.damping != 0 or p.lateral_fluid_damping != 0 else None,  # zero
         fem.form(stiffness_form(p, psi, U, dx)),
         fem.form(gravity_form(p, psi, dx)) if p.gravity != 0 else None,  # g = 0: UFL's zero form
     )

@@ -1,5 +1,5 @@
 """``fenics-drill plot DIR``: the figures of whatever DIR holds - a run, a Monte Carlo study, an
-operating window or a Campbell diagram.
+operating window, a Campbell diagram or a torque-and-drag study.
 
 Every plot records what it was drawn from (``figures.json``: the command's status, rows or realisations, and
 the figures), and marks the figures of a run or study that is running, interrupted, failed or killed with a
@@ -48,15 +48,15 @@ def drawn_from(directory: Path) -> dict:
     except (UnreadableFile, OSError):
         summary = {}
     status = summary.get("status", "unknown")
-    for kind, name in (("campbell", "campbell.json"), ("optimize", "optimize.json"), ("mc", "statistics.h5"),
+    for kind, name in (("torque-drag", "torque_drag.json"), ("campbell", "campbell.json"), ("optimize", "optimize.json"), ("mc", "statistics.h5"),
                        ("run", "timeseries.h5")):
         if (directory / name).exists():
             break
     else:
         said = f" (its command is {status}: {summary.get('message')})" if summary.get("message") else ""
         raise NothingToPlot(f"{directory} holds no timeseries.h5 ('fenics-drill run'), statistics.h5 "
-                            "('fenics-drill mc'), optimize.json ('fenics-drill optimize') or campbell.json "
-                            f"('fenics-drill campbell'){said}")
+                            "('fenics-drill mc'), optimize.json ('fenics-drill optimize'), campbell.json "
+                            f"('fenics-drill campbell') or torque_drag.json ('fenics-drill torque-drag'){said}")
     state = {"kind": kind, "status": status}
     if kind == "run":
         data, attrs = read_series(directory / "timeseries.h5")  # UnreadableFile names a broken file
@@ -79,6 +79,10 @@ def drawn_from(directory: Path) -> dict:
 
 
 def _draw(directory: Path, kind: str, gif: bool) -> list[Path]:
+    if kind == "torque-drag":
+        from fenics_drill.plots.well import well_figures
+
+        return well_figures(directory)
     if kind == "campbell":
         from fenics_drill.plots.campbell import campbell_figure
 

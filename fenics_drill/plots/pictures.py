@@ -57,7 +57,7 @@ def _tube_scene(plotter, snap: FieldSnapshots, k: int, geo: dict, clim=None):
     plotter.camera.zoom(1.6)
 
 
-def _plotter(window_size):
+def off_screen_plotter(window_size):
     """An off-screen PyVista plotter; VTK's complaint about the missing X display is silenced."""
     import pyvista as pv
 
@@ -66,7 +66,7 @@ def _plotter(window_size):
 
 
 def picture_3d(snap: FieldSnapshots, k: int, geo: dict, path: Path, title: str) -> Path:
-    plotter = _plotter((1400, 600))
+    plotter = off_screen_plotter((1400, 600))
     _tube_scene(plotter, snap, k, geo)
     plotter.add_text(f"{title}\n(axial axis compressed to {AXIAL_DIAMETERS:g} borehole diameters)", font_size=10)
     plotter.screenshot(str(path))
@@ -79,7 +79,7 @@ def animation(snap: FieldSnapshots, geo: dict, path: Path) -> Path:
     clim = None
     if "von_mises" in snap.cell_fields:
         clim = (0.0, float(snap.cell_fields["von_mises"].max()) / 1e6)
-    plotter = _plotter((1000, 450))
+    plotter = off_screen_plotter((1000, 450))
     plotter.open_gif(str(path), fps=10)
     for k, t in enumerate(snap.times):
         plotter.clear()

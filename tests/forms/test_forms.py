@@ -18,9 +18,11 @@ from fenics_drill.forms.printed import PRINTED_ERRATA
 from fenics_drill.forms.section_polynomial import annulus_moment
 
 
-@pytest.fixture(scope="module")
-def disc():
-    return BeamDiscretization.from_scene(scene_with("beam.length=3", "beam.elements=6"))
+@pytest.fixture(scope="module", params=["air", "mud"])
+def disc(request):
+    """The paper's pipe, in air and in mud (the mud's lateral added mass and damping enter M, C and the energies)."""
+    mud = ("fluid.density=1200.0", "fluid.lateral_damping=40.0") if request.param == "mud" else ()
+    return BeamDiscretization.from_scene(scene_with("beam.length=3", "beam.elements=6", *mud))
 
 
 def dx_of(disc):

@@ -1,0 +1,124 @@
+"""The soft-string torque-and-drag model (Johancsik, Friesen & Dawson 1984), in vector form along a 3D well.
+
+The string is a cable that lies on the wall: no bending stiffness, so the wall carries, element by element, what
+the tension, the weight and the turn of the axis leave unbalanced.  Each element of length ds, between tangents
+a_t (top) and a_b (bottom), with buoyed weight W = w ds (-z) and effective tensions F_t, F_b, is in equilibrium:
+
+    N + f a = F_t a_t - F_b a_b - W,       a = (a_t + a_b) / |a_t + a_b|,
+
+N perpendicular to the axis (the wall's contact force), f along it: the friction, mu |N| against the slip of the
+contact point, shared between the axis and the circumference by the slip's components (the combined-velocity
+friction of Aadnoy et al.): f = -mu |N| V / |v|, the torque dT = mu |N| r_c (r_c Omega) / |v|, |v| = sqrt(V^2 +
+(r_c Omega)^2), V the axial speed (down-hole > 0), Omega the rotation speed, r_c the contact radius.  In a circular
+arc this gives the capstan law F_t / F_b = (1 + mu tan(beta/2)) / (1 - mu tan(beta/2)) per element, exp(mu beta) as
+the elements shrink (second order); in a straight hole N = w ds sin I and F_t = F_b + w ds (cos I -+ mu sin I).
+Tensions are effective (Lubinski): buoyancy enters through the buoyed weight, and buckling is judged on them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fenics_drill.model.string_sections import StringSection, section_at
+from fenics_drill.model.well import Well
+
+
+@dataclass(frozen=True)
+class Operation:
+    """What the string does: its axial speed (down-hole > 0) [m/s] and rotation speed [rad/s], and the force
+    (tension > 0, so -WOB on bottom) [N] and torque [N m] at the bit."""
+
+    name: str
+    axial_velocity: float
+    rotation_speed: float
+    bit_force: float
+    bit_torque: float
+
+
+def operations(scene) -> list[Operation]:
+    """The operations ``torque_drag.operations`` names, with the study's speeds and bit loads.  Sliding drills with
+    a downhole motor: the bit's weight and the motor's reactive torque, carried by a string that does not turn."""
+    td = scene.torque_drag
+    table = {
+        "rotating_on_bottom": Operation("rotating_on_bottom", td.rate_of_penetration, td.rotation_speed,
+                                        -td.weight_on_bit, td.torque_on_bit),
+        "rotating_off_bottom": Operation("rotating_off_bottom", 0.0, td.rotation_speed, 0.0, 0.0),
+        "sliding": Operation("sliding", td.rate_of_penetration, 0.0, -td.weight_on_bit, td.torque_on_bit),
+        "tripping_in": Operation("tripping_in", td.trip_speed, 0.0, 0.0, 0.0),
+        "tripping_out": Operation("tripping_out", -td.trip_speed, 0.0, 0.0, 0.0),
+    }
+    return [table[name] for name in td.operations]
+
+
+@dataclass(frozen=True)
+class StringMesh:
+    """The string's nodes along measured depth (0 at the surface, the bit last) and each element's properties."""
+
+    md: np.ndarray  # nodes [m]
+    tangent: np.ndarray  # unit, down-hole, at the nodes
+    weight: np.ndarray  # buoyed weight per length of each element [N/m]
+    contact_radius: np.ndarray  # [m]
+    friction: np.ndarray  # the hole's coefficient [-]
+    section: np.ndarray  # index into the string's sections
+
+
+def string_mesh(well: Well, sections: list[StringSection], element_length: float, weights: np.ndarray,
+                friction_cased: float, friction_open: float) -> StringMesh:
+    """Nodes at most ``element_length`` apart that fall on every survey station, section end and hole-section
+    bottom, so that each element has one set of properties and lies on one arc.  ``weights``: each section's
+    buoyed weight per length."""
+    length = sections[-1].bottom
+    breaks = {0.0, length, *(s.bottom for s in sections), *well.trajectory.md, *well.hole.bottoms}
+    breaks = np.array(sorted(b for b in breaks if 0.0 <= b <= length))
+    nodes = [breaks[:1]]
+    for a, b in zip(breaks[:-1], breaks[1:]):
+        count = max(1, math.ceil((b - a) / element_length - 1e-9))
+        nodes.append(np.linspace(a, b, count + 1)[1:])
+    md = np.concatenate(nodes)
+    middle = 0.5 * (md[1:] + md[:-1])
+    index = section_at(sections, middle)
+    hole = well.hole.at(middle)
+    return StringMesh(md=md, tangent=well.trajectory.tangents(md), weight=np.asarray(weights)[index],
+                      contact_radius=np.array([sections[k].contact_radius for k in index]),
+                      friction=np.where(well.hole.cased[hole], friction_cased, friction_open), section=index)
+
+
+def soft_string(mesh: StringMesh, operation: Operation, iterations: int = 50) -> dict[str, np.ndarray]:
+    """Effective tension [N] and torque [N m] at the nodes, from the bit up, and the wall's contact force per
+    length [N/m] on each element, for one operation."""
+    n = mesh.md.size
+    tension, torque = np.empty(n), np.empty(n)
+    normal = np.empty(n - 1)
+    tension[-1], torque[-1] = operation.bit_force, operation.bit_torque
+    down = np.array([0.0, 0.0, -1.0])
+    for k in range(n - 2, -1, -1):
+        a_t, a_b = mesh.tangent[k], mesh.tangent[k + 1]
+        axis = a_t + a_b
+        axis /= np.linalg.norm(axis)
+        cos_half = float(a_t @ axis)
+        ds = mesh.md[k + 1] - mesh.md[k]
+        weight = mesh.weight[k] * ds * down
+        r, mu = mesh.contact_radius[k], mesh.friction[k]
+        surface = r * operation.rotation_speed
+        slip = math.hypot(operation.axial_velocity, surface)
+        axial_share = operation.axial_velocity / slip if slip > 0 else 0.0
+        turning_share = surface / slip if slip > 0 else 0.0
+        f_b = tension[k + 1]
+        f_t = f_b + float(weight @ axis) / cos_half
+        for _ in range(iterations):
+            load = f_t * a_t - f_b * a_b - weight
+            wall = float(np.linalg.norm(load - (load @ axis) * axis))
+            updated = f_b + (float(weight @ axis) - mu * wall * axial_share) / cos_half
+            converged = abs(updated - f_t) <= 1e-12 * (abs(updated) + abs(f_b) + 1.0)
+            f_t = updated
+            if converged:
+                break
+        load = f_t * a_t - f_b * a_b - weight
+        wall = float(np.linalg.norm(load - (load @ axis) * axis))
+        tension[k] = f_t
+        torque[k] = torque[k + 1] + mu * wall * r * turning_share
+        normal[k] = wall / ds
+    return {"tension": tension, "torque": torque, "wall_force_per_length": normal}

@@ -1,0 +1,252 @@
+"""The well: its axis from a survey by the minimum-curvature method, and the hole's sections along it.
+
+A survey lists stations (measured depth s, inclination I from the vertical, azimuth A from north, clockwise).
+Between two stations the axis is the circular arc that joins their tangents (minimum curvature): with the
+dogleg angle beta between the tangents t1, t2, the displacement is (t1 + t2) (s2 - s1) / 2 RF(beta) with
+RF = tan(beta/2) / (beta/2), and the tangent turns in their plane at the constant curvature beta / (s2 - s1).
+Coordinates: x north, y east, z up (true vertical depth is -z); the tangent points down-hole.
+"""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from fenics_drill.scene import SceneError
+
+#: Largest dogleg a pipe can pass in a well [deg per 30 m]: beyond this a survey is refused as a typing error
+#: (the tightest short-radius wells build at about 2-3 deg per metre).
+MAX_DOGLEG_DEG_PER_30M = 90.0
+
+
+class SurveyError(ValueError):
+    """A survey that cannot describe a well; the message names the station or the column."""
+
+
+def tangent(inclination: np.ndarray, azimuth: np.ndarray) -> np.ndarray:
+    """Unit tangents (north, east, up) pointing down-hole, from inclination and azimuth [rad]."""
+    inclination, azimuth = np.asarray(inclination, dtype=float), np.asarray(azimuth, dtype=float)
+    return np.stack([np.sin(inclination) * np.cos(azimuth), np.sin(inclination) * np.sin(azimuth),
+                     -np.cos(inclination)], axis=-1)
+
+
+@dataclass(frozen=True)
+class Survey:
+    """Survey stations: measured depth [m], inclination and azimuth [rad]."""
+
+    md: np.ndarray
+    inclination: np.ndarray
+    azimuth: np.ndarray
+
+    @classmethod
+    def of(cls, md, inclination_deg, azimuth_deg, where: str = "the survey") -> "Survey":
+        """Checked stations from degrees: at least two, depths strictly increasing, angles finite, inclination in
+        [0, 180], doglegs a pipe can pass."""
+        md, inc, azi = (np.asarray(a, dtype=float) for a in (md, inclination_deg, azimuth_deg))
+        if not (md.ndim == inc.ndim == azi.ndim == 1 and md.size == inc.size == azi.size):
+            raise SurveyError(f"{where}: md, inclination and azimuth must be three lists of the same length "
+                              f"(got {md.size}, {inc.size}, {azi.size})")
+        if md.size < 2:
+            raise SurveyError(f"{where}: at least two stations are needed, got {md.size}")
+        for name, values in (("md", md), ("inclination", inc), ("azimuth", azi)):
+            bad = np.flatnonzero(~np.isfinite(values))
+            if bad.size:
+                raise SurveyError(f"{where}, station {bad[0] + 1}: {name} = {values[bad[0]]!r} is not a number")
+        step = np.diff(md)
+        if np.any(step <= 0):
+            k = int(np.flatnonzero(step <= 0)[0])
+            raise SurveyError(f"{where}, station {k + 2}: md = {md[k + 1]:g} m does not exceed the station before "
+                              f"({md[k]:g} m): a survey is sorted by measured depth, without repeats")
+        bad = np.flatnonzero((inc < 0) | (inc > 180))
+        if bad.size:
+            raise SurveyError(f"{where}, station {bad[0] + 1}: inclination = {inc[bad[0]]:g} deg is not in [0, 180]")
+        survey = cls(md, np.radians(inc), np.radians(azi))
+        dls = np.degrees(survey.doglegs()) / step * 30.0
+        if np.any(dls > MAX_DOGLEG_DEG_PER_30M):
+            k = int(np.argmax(dls))
+            raise SurveyError(f"{where}, stations {k + 1}-{k + 2}: a dogleg of {dls[k]:.3g} deg/30 m, more than any "
+                              f"pipe can pass ({MAX_DOGLEG_DEG_PER_30M:g} deg/30 m): check the depths and angles")
+        return survey
+
+    def doglegs(self) -> np.ndarray:
+        """The angle between consecutive stations' tangents [rad]."""
+        t = tangent(self.inclination, self.azimuth)
+        return np.arccos(np.clip(np.einsum("ij,ij->i", t[:-1], t[1:]), -1.0, 1.0))
+
+
+def read_survey_csv(path: Path) -> Survey:
+    """A survey from a CSV file with a header naming the columns md, inclination and azimuth (m, degrees; other
+    columns are ignored); errors name the file and the row."""
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+    except OSError as err:
+        raise SurveyError(f"survey file {path} cannot be read: {err.strerror}") from err
+    if not rows:
+        raise SurveyError(f"survey file {path} holds no stations")
+    columns = {name.strip().lower(): name for name in rows[0]}
+    missing = [c for c in ("md", "inclination", "azimuth") if c not in columns]
+    if missing:
+        raise SurveyError(f"survey file {path}: no column {', '.join(missing)} (its header names "
+                          f"{', '.join(columns)}); the columns are md [m], inclination and azimuth [deg]")
+    values = {c: [] for c in ("md", "inclination", "azimuth")}
+    for k, row in enumerate(rows, start=2):
+        for c in values:
+            try:
+                values[c].append(float(row[columns[c]]))
+            except (TypeError, ValueError):
+                raise SurveyError(f"survey file {path}, line {k}: {c} = {row[columns[c]]!r} is not a number") from None
+    return Survey.of(values["md"], values["inclination"], values["azimuth"], where=f"survey file {path}")
+
+
+class Trajectory:
+    """The well's axis by minimum curvature: position, tangent and curvature at any measured depth."""
+
+    def __init__(self, survey: Survey):
+        self.survey = survey
+        self.md = survey.md
+        self.t = tangent(survey.inclination, survey.azimuth)
+        beta = survey.doglegs()
+        self.beta = beta
+        length = np.diff(self.md)
+        ratio = np.where(beta > 1e-9, np.tan(beta / 2) / np.where(beta > 1e-9, beta / 2, 1.0), 1.0)
+        steps = 0.5 * length[:, None] * ratio[:, None] * (self.t[:-1] + self.t[1:])
+        self.stations = np.vstack([np.zeros(3), np.cumsum(steps, axis=0)])
+
+    @property
+    def length(self) -> float:
+        return float(self.md[-1] - self.md[0])
+
+    def _segment(self, s: np.ndarray) -> np.ndarray:
+        return np.clip(np.searchsorted(self.md, s, side="right") - 1, 0, len(self.md) - 2)
+
+    def tangents(self, s) -> np.ndarray:
+        """Unit tangents (down-hole) at measured depths ``s``: the slerp of the stations' tangents along each arc."""
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        k = self._segment(s)
+        share = np.clip((s - self.md[k]) / (self.md[k + 1] - self.md[k]), 0.0, 1.0)
+        beta = self.beta[k]
+        t1, t2 = self.t[k], self.t[k + 1]
+        small = beta < 1e-9
+        safe = np.where(small, 1.0, beta)
+        a = np.where(small, 1.0 - share, np.sin((1 - share) * safe) / np.sin(safe))
+        b = np.where(small, share, np.sin(share * safe) / np.sin(safe))
+        out = a[:, None] * t1 + b[:, None] * t2
+        return out / np.linalg.norm(out, axis=1)[:, None]
+
+    def positions(self, s) -> np.ndarray:
+        """Positions (north, east, up) [m] at measured depths ``s``, on the arcs of minimum curvature."""
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        k = self._segment(s)
+        beta = self.beta[k]
+        length = self.md[k + 1] - self.md[k]
+        share = np.clip((s - self.md[k]) / length, 0.0, 1.0)
+        t1, t2 = self.t[k], self.t[k + 1]
+        small = beta < 1e-9
+        safe = np.where(small, 1.0, beta)
+        # the slerp integrated from the station: r = L / (beta sin beta) [(cos((1-f) beta) - cos beta) t1 + (1 - cos f beta) t2]
+        denominator = safe * np.sin(safe)
+        c1 = np.where(small, share - share**2 / 2, (np.cos((1 - share) * safe) - np.cos(safe)) / denominator)
+        c2 = np.where(small, share**2 / 2, (1 - np.cos(share * safe)) / denominator)
+        return self.stations[k] + length[:, None] * (c1[:, None] * t1 + c2[:, None] * t2)
+
+    def curvature(self, s) -> np.ndarray:
+        """The axis' curvature [1/m] at measured depths ``s``: beta / length of the arc they lie on."""
+        k = self._segment(np.atleast_1d(np.asarray(s, dtype=float)))
+        return self.beta[k] / (self.md[k + 1] - self.md[k])
+
+    def inclination(self, s) -> np.ndarray:
+        """Inclination from the vertical [rad] at measured depths ``s``."""
+        return np.arccos(np.clip(-self.tangents(s)[:, 2], -1.0, 1.0))
+
+
+def straight_survey(length: float, inclination_deg: float = 90.0, azimuth_deg: float = 0.0) -> Survey:
+    """A straight hole of ``length`` at a fixed inclination and azimuth (the paper's: horizontal)."""
+    return Survey.of([0.0, length], [inclination_deg] * 2, [azimuth_deg] * 2)
+
+
+def dogleg_severity_deg_per_30m(survey: Survey) -> np.ndarray:
+    """Dogleg severity of each survey interval, in degrees per 30 m (the industry's unit)."""
+    return np.degrees(survey.doglegs()) / np.diff(survey.md) * 30.0
+
+
+@dataclass(frozen=True)
+class HoleSections:
+    """The hole along measured depth: section k spans down to ``bottoms[k]``, with its radius and whether it is
+    cased (its friction coefficient is the cased hole's) or open."""
+
+    bottoms: np.ndarray
+    radii: np.ndarray
+    cased: np.ndarray
+
+    def at(self, s) -> np.ndarray:
+        """The index of the hole section at measured depths ``s``."""
+        index = np.searchsorted(self.bottoms, np.atleast_1d(np.asarray(s, dtype=float)), side="left")
+        return np.clip(index, 0, len(self.radii) - 1)
+
+    def radius(self, s) -> np.ndarray:
+        return self.radii[self.at(s)]
+
+
+@dataclass(frozen=True)
+class Well:
+    """A scene's well: its axis (from the survey) and its hole sections."""
+
+    trajectory: Trajectory
+    hole: HoleSections
+
+    @property
+    def depth(self) -> float:
+        """Measured depth of the last survey station (total depth) [m]."""
+        return float(self.trajectory.md[-1])
+
+
+def well_of(scene, string_length: float) -> Well:
+    """The well of a scene's ``[well]`` table (raises SceneError naming the key, the file or the station): the
+    survey from ``well.survey`` or the inline stations, started at the surface (a first station below md 0 is
+    reached by a straight hole at its own angles), and the hole sections (one open hole of ``borehole.radius``
+    when none are given).  Without stations, the paper's straight horizontal hole of ``string_length``."""
+    w = scene.well
+    if w.survey and w.md:
+        raise SceneError("well.survey and well.md are not admissible together: give the stations in a file or "
+                         "inline, not both")
+    try:
+        if w.survey:
+            survey = read_survey_csv(Path(w.survey))
+        elif w.md:
+            survey = Survey.of(w.md, w.inclination, w.azimuth, where="well.md/inclination/azimuth")
+        else:
+            survey = straight_survey(string_length)
+    except SurveyError as err:
+        raise SceneError(str(err)) from None
+    if survey.md[0] < 0:
+        raise SceneError(f"the survey's first station is at md = {survey.md[0]:g} m: measured depth is counted "
+                         "from the surface, >= 0")
+    if survey.md[0] > 0:
+        survey = Survey(np.concatenate([[0.0], survey.md]), np.concatenate([survey.inclination[:1], survey.inclination]),
+                        np.concatenate([survey.azimuth[:1], survey.azimuth]))
+    depth = float(survey.md[-1])
+    count = len(w.hole_radius)
+    if len(w.hole_bottom) != count or (w.hole_cased and len(w.hole_cased) != count):
+        raise SceneError(f"well.hole_bottom ({len(w.hole_bottom)}), well.hole_radius ({count}) and well.hole_cased "
+                         f"({len(w.hole_cased)}) must list the same hole sections (hole_cased may be left out: open)")
+    if count:
+        bottoms, radii = np.asarray(w.hole_bottom, dtype=float), np.asarray(w.hole_radius, dtype=float)
+        if np.any(np.diff(bottoms) <= 0) or bottoms[0] <= 0:
+            raise SceneError(f"well.hole_bottom = {list(w.hole_bottom)} is not admissible: the sections' bottoms "
+                             "must be > 0 and increasing")
+        if bottoms[-1] < depth:
+            raise SceneError(f"well.hole_bottom = {list(w.hole_bottom)} is not admissible: the last section must "
+                             f"reach the survey's last station at md = {depth:g} m")
+        if np.any(radii <= 0):
+            raise SceneError(f"well.hole_radius = {list(w.hole_radius)} is not admissible: every radius must be > 0")
+        cased = np.asarray(w.hole_cased or [False] * count, dtype=bool)
+    else:
+        bottoms, radii, cased = np.array([depth]), np.array([scene.borehole.radius]), np.array([False])
+    if string_length > depth * (1 + 1e-9):
+        raise SceneError(f"the string ({string_length:g} m) is longer than the well ({depth:g} m of measured depth): "
+                         "shorten string.sections or extend the survey")
+    return Well(Trajectory(survey), HoleSections(bottoms, radii, cased))

@@ -1,0 +1,135 @@
+"""``fenics-drill torque-drag``: hook load, surface torque and the profiles along a well of the soft-string model
+(:mod:`fenics_drill.model.soft_string`) for each operation, with the buckling loads of the pipe in its hole
+(:mod:`fenics_drill.observables.buckling`).
+
+Files: ``torque_drag.json`` (the well, the string, and per operation the surface loads and where the string buckles),
+``torque_drag.h5`` (the profiles, an xarray/netCDF-4 dataset over the nodes' measured depth) and ``well.vtu`` (the
+string's axis with its profiles, for ParaView).
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import meshio
+import numpy as np
+
+from fenics_drill.io.files import write_atomic, write_json
+from fenics_drill.model.soft_string import operations, soft_string, string_mesh
+from fenics_drill.model.string_sections import string_sections
+from fenics_drill.model.well import dogleg_severity_deg_per_30m, well_of
+from fenics_drill.observables.buckling import helical_load, sinusoidal_load
+from fenics_drill.scene import SceneError
+from fenics_drill.studies.lifecycle import command_output
+
+
+def _fluids(scene) -> tuple[float, float]:
+    outer = scene.fluid.density
+    return outer, outer if scene.fluid.inner_density == -1.0 else scene.fluid.inner_density
+
+
+def torque_drag_study(scene) -> dict:
+    """The soft-string study of a scene: ``report`` (JSON-ready) and ``profiles`` (an ``xarray.Dataset``: node values
+    over ``md``, element values over ``md_element``)."""
+    clock = time.perf_counter()
+    sections = string_sections(scene)
+    well = well_of(scene, sections[-1].bottom)
+    g = scene.environment.gravity
+    outer, inner = _fluids(scene)
+    weights = np.array([s.buoyed_weight(g, outer, inner) for s in sections])
+    td = scene.torque_drag
+    mesh = string_mesh(well, sections, td.element_length, weights, td.friction_cased, td.friction_open)
+    middle = 0.5 * (mesh.md[1:] + mesh.md[:-1])
+    clearance = well.hole.radius(middle) - mesh.contact_radius
+    if np.any(clearance <= 0):
+        k = int(np.argmin(clearance))
+        name = sections[mesh.section[k]].name
+        raise SceneError(f"string section '{name}' (contact radius {mesh.contact_radius[k]:g} m) does not fit the hole "
+                         f"of radius {well.hole.radius(middle[k])[0]:g} m at md = {middle[k]:.1f} m")
+    trajectory = well.trajectory
+    inclination = trajectory.inclination(middle)
+    stiffness = np.array([sections[k].bending_stiffness for k in mesh.section])
+    curvature = trajectory.curvature(middle)
+    f_sin = sinusoidal_load(stiffness, mesh.weight, inclination, clearance, curvature)
+    f_hel = helical_load(stiffness, mesh.weight, inclination, clearance, curvature)
+    position = trajectory.positions(mesh.md)
+    profiles = {"md": mesh.md, "north": position[:, 0], "east": position[:, 1], "tvd": -position[:, 2],
+                "md_element": middle, "inclination_deg": np.degrees(inclination),
+                "sinusoidal_buckling_load": f_sin, "helical_buckling_load": f_hel}
+    results = {}
+    for operation in operations(scene):
+        loads = soft_string(mesh, operation)
+        compression = -0.5 * (loads["tension"][1:] + loads["tension"][:-1])
+        ds = np.diff(mesh.md)
+        sinusoidal = (compression > f_sin) & (compression <= f_hel)
+        helical = compression > f_hel
+        for name, values in loads.items():
+            profiles[f"{name}_{operation.name}"] = values
+        profiles[f"buckling_{operation.name}"] = np.where(helical, 2, np.where(sinusoidal, 1, 0))
+        results[operation.name] = {
+            "hook_load_N": float(loads["tension"][0]),
+            "surface_torque_Nm": float(loads["torque"][0]),
+            "axial_velocity_m_s": operation.axial_velocity, "rotation_speed_rad_s": operation.rotation_speed,
+            "bit_force_N": operation.bit_force, "bit_torque_Nm": operation.bit_torque,
+            "max_compression_N": float(max(compression.max(), 0.0)),
+            "sinusoidally_buckled_length_m": float(ds[sinusoidal].sum()),
+            "helically_buckled_length_m": float(ds[helical].sum()),
+            "first_buckled_md_m": float(middle[sinusoidal | helical][0]) if np.any(sinusoidal | helical) else None,
+            "max_wall_force_per_length_N_m": float(loads["wall_force_per_length"].max()),
+            # the hook cannot push: a string that needs a negative hook load does not go down (lock-up)
+            "locked_up": bool(loads["tension"][0] < 0.0),
+        }
+    survey = trajectory.survey
+    report = {
+        "well": {"measured_depth_m": well.depth, "true_vertical_depth_m": float(-trajectory.stations[-1, 2]),
+                 "horizontal_displacement_m": float(np.hypot(*trajectory.stations[-1, :2])),
+                 "max_inclination_deg": float(np.degrees(survey.inclination.max())),
+                 "max_dogleg_deg_per_30m": float(dogleg_severity_deg_per_30m(survey).max()),
+                 "hole_sections": [{"bottom_m": float(b), "radius_m": float(r), "cased": bool(c)}
+                                   for b, r, c in zip(well.hole.bottoms, well.hole.radii, well.hole.cased)]},
+        "string": {"length_m": sections[-1].bottom, "bit_md_m": sections[-1].bottom,
+                   "weight_in_air_N": float(sum(g * s.mass_per_length * (s.bottom - s.top) for s in sections)),
+                   "buoyed_weight_N": float(sum(w * (s.bottom - s.top) for s, w in zip(sections, weights))),
+                   "sections": [{"name": s.name, "top_m": s.top, "bottom_m": s.bottom,
+                                 "buoyed_weight_N_m": float(w), "contact_radius_m": s.contact_radius}
+                                for s, w in zip(sections, weights)]},
+        "fluid": {"density_kg_m3": outer, "inner_density_kg_m3": inner},
+        "elements": int(mesh.md.size - 1),
+        "operations": results,
+        "wall_time_s": time.perf_counter() - clock,
+    }
+    return {"report": report, "profiles": _dataset(profiles)}
+
+
+def _dataset(profiles: dict):
+    """The profiles as an ``xarray.Dataset``: node values over ``md``, element values over ``md_element``."""
+    import xarray
+
+    nodes = profiles["md"].size
+    variables = {name: (("md" if values.size == nodes else "md_element"), values)
+                 for name, values in profiles.items() if name not in ("md", "md_element")}
+    return xarray.Dataset(variables, coords={"md": profiles["md"], "md_element": profiles["md_element"]})
+
+
+def _write_vtu(path: Path, profiles) -> None:
+    """The string's axis as a polyline (x north, y east, z up) with its node profiles, for ParaView."""
+    points = np.column_stack([profiles["north"].values, profiles["east"].values, -profiles["tvd"].values])
+    cells = [("line", np.column_stack([np.arange(points.shape[0] - 1), np.arange(1, points.shape[0])]))]
+    data = {name: values.values for name, values in profiles.data_vars.items() if values.dims == ("md",)}
+    write_atomic(path, lambda tmp: meshio.write_points_cells(str(tmp), points, cells, point_data=data,
+                                                             file_format="vtu"))
+
+
+def write_torque_drag(scene, out: str | Path, overwrite: bool = False) -> dict:
+    """``fenics-drill torque-drag``: DIR/torque_drag.json, torque_drag.h5, well.vtu and summary.json."""
+    out = Path(out)
+    with command_output(out, "torque-drag", scene, overwrite) as summary:
+        study = torque_drag_study(scene)
+        write_json(out / "torque_drag.json", study["report"])
+        write_atomic(out / "torque_drag.h5", lambda tmp: study["profiles"].to_netcdf(tmp, engine="h5netcdf"))
+        _write_vtu(out / "well.vtu", study["profiles"])
+        summary["message"] = "torque_drag.json"
+        summary["hook_load_N"] = {k: v["hook_load_N"] for k, v in study["report"]["operations"].items()}
+        summary["surface_torque_Nm"] = {k: v["surface_torque_Nm"] for k, v in study["report"]["operations"].items()}
+    return study
