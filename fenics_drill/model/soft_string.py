@@ -122,3 +122,20 @@ def soft_string(mesh: StringMesh, operation: Operation, iterations: int = 50) ->
         torque[k] = torque[k + 1] + mu * wall * r * turning_share
         normal[k] = wall / ds
     return {"tension": tension, "torque": torque, "wall_force_per_length": normal}
+
+
+def stretch(mesh: StringMesh, sections: list[StringSection], tension: np.ndarray, depth: np.ndarray,
+            gravity: float, outer_density: float, inner_density: float) -> float:
+    """The string's elongation [m] under its loads in the mud: the axial strain of each element from the effective
+    tension F and the hydrostatic pressures p = rho g z at its true vertical depth z (Lame's tube: the radial and hoop
+    stresses sum to 2 (p_i A_i - p_o A_o) / A_s), eps = (F + (1 - 2 nu)(p_i A_i - p_o A_o)) / (E A_s), over the
+    pipe body's areas.  A string hanging in one mud stretches g L^2 (rho_s - 2 rho_m (1 - nu)) / (2 E)."""
+    total = 0.0
+    force = 0.5 * (tension[1:] + tension[:-1])
+    for k, ds in enumerate(np.diff(mesh.md)):
+        section = sections[mesh.section[k]]
+        outer, inner = math.pi * section.outer_radius**2, section.inner_area
+        pressures = gravity * depth[k] * (inner_density * inner - outer_density * outer)
+        steel = outer - inner
+        total += (force[k] + (1 - 2 * section.poisson_ratio) * pressures) * ds / (section.young_modulus * steel)
+    return total

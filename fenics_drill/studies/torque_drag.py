@@ -16,7 +16,7 @@ import meshio
 import numpy as np
 
 from fenics_drill.io.files import write_atomic, write_json
-from fenics_drill.model.soft_string import operations, soft_string, string_mesh
+from fenics_drill.model.soft_string import operations, soft_string, stretch, string_mesh
 from fenics_drill.model.string_sections import string_sections
 from fenics_drill.model.well import dogleg_severity_deg_per_30m, well_of
 from fenics_drill.observables.buckling import helical_load, sinusoidal_load
@@ -77,6 +77,8 @@ def torque_drag_study(scene) -> dict:
             "helically_buckled_length_m": float(ds[helical].sum()),
             "first_buckled_md_m": float(middle[sinusoidal | helical][0]) if np.any(sinusoidal | helical) else None,
             "max_wall_force_per_length_N_m": float(loads["wall_force_per_length"].max()),
+            "stretch_m": stretch(mesh, sections, loads["tension"], -0.5 * (position[1:, 2] + position[:-1, 2]), g,
+                                 outer, inner),
             # the hook cannot push: a string that needs a negative hook load does not go down (lock-up)
             "locked_up": bool(loads["tension"][0] < 0.0),
         }

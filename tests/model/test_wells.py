@@ -239,3 +239,18 @@ def test_the_mud_moves_with_the_lateral_motion_only():
     wide = load_scene(None, ["fluid.density=1000.0", "borehole.radius=80.0"])
     unconfined = math.pi * 1000.0 * (b.inner_radius**2 + b.outer_radius**2)
     assert wide.lateral_added_mass == pytest.approx(unconfined, rel=1e-5)
+
+
+def test_a_hanging_string_stretches_under_its_weight_in_the_mud():
+    """A plain pipe hanging in a vertical hole with mud inside and out stretches g L^2 (rho_s - 2 rho_m (1 - nu)) /
+    (2 E): the true tension rho_s g A (L - z) - rho_m g L A and the Poisson shortening of the hydrostatic radial and
+    hoop stresses (Lubinski).  The strain is linear along the string and the midpoint rule integrates it exactly
+    (round-off)."""
+    from fenics_drill.studies.torque_drag import torque_drag_study
+
+    s = scene("fluid.density=1200.0", "torque_drag.operations=['tripping_out', 'rotating_off_bottom']",
+              well={"md": [0.0, 1000.0], "inclination": [0.0, 0.0], "azimuth": [0.0, 0.0]})
+    b = s.beam
+    expected = G * 1000.0**2 * (b.density - 2 * 1200.0 * (1 - b.poisson_ratio)) / (2 * b.young_modulus)
+    for op in torque_drag_study(s)["report"]["operations"].values():
+        assert op["stretch_m"] == pytest.approx(expected, rel=1e-10)
