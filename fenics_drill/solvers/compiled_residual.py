@@ -33,6 +33,8 @@ _KINDS = {Gravity: GRAVITY, WallContact: WALL, BitRock: BIT_ROCK, OutOfBandDampi
 #: What :func:`residual_at` gives of a wall and a bit the model does not have.
 NO_WALL = (np.empty(0), np.empty((0, 4)), np.empty((0, 4, 3)), 0.0, np.empty(0), np.empty((0, 2)), np.empty((0, 4)))
 NO_BIT = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+#: The wall law's constants (:meth:`WallContact._law`'s order and types) of a model without a wall.
+NO_WALL_LAW = (0.0,) * 4 + (False,) + (0.0,) * 4 + (False,)
 
 
 @njit(cache=True)
@@ -120,7 +122,7 @@ class CompiledResidual:
         gravity, bit, damping = (self.model.force(name) for name in (Gravity.name, BitRock.name,
                                                                     OutOfBandDamping.name))
         wall = (self.wall.kernel_data(vertices) if self.wall is not None else
-                (NO_ROWS, (0.0,) * 4 + (False,) + (0.0,) * 4, np.zeros(size), np.zeros(size), np.inf))
+                (NO_ROWS, NO_WALL_LAW, np.zeros(size), np.zeros(size), np.inf))
         bit_data = bit.kernel_data() if bit is not None else (np.empty((2, size)), np.empty((2, size)), (0.0,) * 4)
         return (np.zeros(size) if gravity is None else gravity.load, *wall, *bit_data,
                 np.empty((0, size)) if damping is None else damping.damping)
