@@ -18,17 +18,29 @@ from __future__ import annotations
 
 import ufl
 
-from .properties import BeamProperties
+from .properties import BeamProperties, CurvedAxis
 from .section_polynomial import SectionPolynomial
 
 #: Arguments of the strain energy density: the only ways it depends on U.
 STRAIN_SLOTS = ("theta_x", "theta_y", "theta_z", "du", "dv", "dw", "dtheta_x", "dtheta_y", "dtheta_z")
 
 
-def strain_slots(U) -> dict:
-    """theta_x, theta_y, theta_z and the axial derivatives u', v', w', theta_x', theta_y', theta_z'."""
-    d = lambda f: f.dx(0)  # noqa: E731
-    return dict(zip(STRAIN_SLOTS, (U[3], U[4], U[5], d(U[0]), d(U[1]), d(U[2]), d(U[3]), d(U[4]), d(U[5]))))
+def axial_derivatives(U, axis: CurvedAxis | None = None) -> tuple:
+    """The derivatives along the axis of the displacement (u, v, w) and rotation (theta_x, theta_y, theta_z)
+    vectors, as components in the axis' frame.  On a curved axis (Bishop frame, curvature (k2, k3)) the frame turns:
+    (a t + b d2 + c d3)' = (a' - k2 b - k3 c) t + (b' + k2 a) d2 + (c' + k3 a) d3 (docs/wells.md)."""
+    d = [U[i].dx(0) for i in range(6)]
+    if axis is None:
+        return tuple(d)
+    k2, k3 = axis.curvature
+    return (d[0] - k2 * U[1] - k3 * U[2], d[1] + k2 * U[0], d[2] + k3 * U[0],
+            d[3] - k2 * U[4] - k3 * U[5], d[4] + k2 * U[3], d[5] + k3 * U[3])
+
+
+def strain_slots(U, axis: CurvedAxis | None = None) -> dict:
+    """theta_x, theta_y, theta_z and the axial derivatives u', v', w', theta_x', theta_y', theta_z' (in the frame
+    of a curved ``axis``: :func:`axial_derivatives`)."""
+    return dict(zip(STRAIN_SLOTS, (U[3], U[4], U[5], *axial_derivatives(U, axis))))
 
 
 #: Kinematics of the cross-section (docs/errata.md, "Kinematics (14)"):
@@ -142,7 +154,7 @@ def inertial_force(p: BeamProperties, psi, U, V, A, dx, inertial_nonlinearity: b
 def elastic_force(p: BeamProperties, psi, U, dx, geometric_nonlinearity: bool = True, kinematics: str = "objective",
                   weight=1.0):
     """dV/dU [psi] (= K(psi, U) - F_SE(psi), Eqs. 46, 49); ``weight`` as for :func:`inertial_force`."""
-    W = strain_energy_density(p, strain_slots(U), geometric_nonlinearity, kinematics)
+    W = strain_energy_density(p, strain_slots(U, p.axis), geometric_nonlinearity, kinematics)
     return ufl.derivative(weight * W * dx, U, psi)
 
 
@@ -155,6 +167,6 @@ def strain_energy_gradient_terms(p: BeamProperties, U, geometric_nonlinearity: b
                                  kinematics: str = "objective") -> dict:
     """dW/d(slot) for each slot of :data:`STRAIN_SLOTS`: the factors multiplying psi_tx, ...,
     psi_tz' in dV/dU[psi] (the energy-derived counterparts of Gamma_1..Gamma_9 plus K)."""
-    slots = {name: ufl.variable(expr) for name, expr in strain_slots(U).items()}
+    slots = {name: ufl.variable(expr) for name, expr in strain_slots(U, p.axis).items()}
     W = strain_energy_density(p, slots, geometric_nonlinearity, kinematics)
     return {name: ufl.diff(W, var) for name, var in slots.items()}

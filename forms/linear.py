@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ufl
 
+from .energies import axial_derivatives
 from .properties import BeamProperties
 
 
@@ -40,20 +41,25 @@ def stiffness_form(p: BeamProperties, psi, U, dx):
     """Stiffness operator K(psi, U), Eq. (46).
 
     Axial E A u'; bending E I4 theta_y', theta_z'; torsion 2 kappa_s G I4 theta_x';
-    shear kappa_s G A (theta_y + w') and (theta_z - v').
+    shear kappa_s G A (theta_y + w') and (theta_z - v'); on a curved axis the derivatives are the frame's
+    (:func:`~fenics_drill.forms.energies.axial_derivatives`).
     """
     s = p.section
     E, G, ks = p.young_modulus, p.shear_modulus, p.shear_factor
-    d = lambda f: f.dx(0)  # noqa: E731 - derivative along the beam axis
-    axial = E * s.area * d(psi[0]) * d(U[0])
-    bending = E * s.I4 * (d(psi[4]) * d(U[4]) + d(psi[5]) * d(U[5]))
-    torsion = 2.0 * ks * G * s.I4 * d(psi[3]) * d(U[3])
-    shear = ks * G * s.area * (
-        (psi[4] + d(psi[2])) * (U[4] + d(U[2])) + (psi[5] - d(psi[1])) * (U[5] - d(U[1]))
-    )
+    du, dv, dw, dtx, dty, dtz = axial_derivatives(U, p.axis)
+    dpu, dpv, dpw, dptx, dpty, dptz = axial_derivatives(psi, p.axis)
+    axial = E * s.area * dpu * du
+    bending = E * s.I4 * (dpty * dty + dptz * dtz)
+    torsion = 2.0 * ks * G * s.I4 * dptx * dtx
+    shear = ks * G * s.area * ((psi[4] + dpw) * (U[4] + dw) + (psi[5] - dpv) * (U[5] - dv))
     return (axial + bending + torsion + shear) * dx
 
 
 def gravity_form(p: BeamProperties, psi, dx):
-    """Gravity load F_G(psi) = -int rho A g psi_w dx, Eq. (52); gravity points along -z."""
-    return -p.density * p.section.area * p.gravity * psi[2] * dx
+    """Gravity load F_G(psi) = -int rho A g psi_w dx, Eq. (52); gravity points along -z.  On a curved axis,
+    int rho A g (down_t psi_u + down_2 psi_v + down_3 psi_w) dx with the downward vertical in the axis' frame."""
+    weight = p.density * p.section.area * p.gravity
+    if p.axis is None:
+        return -weight * psi[2] * dx
+    down_t, down_2, down_3 = p.axis.down
+    return weight * (down_t * psi[0] + down_2 * psi[1] + down_3 * psi[2]) * dx

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 
 @dataclass(frozen=True)
@@ -30,6 +30,17 @@ def section_constants(outer_radius: float, inner_radius: float) -> SectionConsta
 
 
 @dataclass(frozen=True)
+class CurvedAxis:
+    """The borehole axis the beam lies along, as UFL coefficients on the mesh: the axis' curvature (k2, k3) [1/m]
+    in its Bishop frame (t, d2, d3), with t' = k2 d2 + k3 d3, d2' = -k2 t, d3' = -k3 t, and the unit downward
+    vertical's components (down_t, down_2, down_3) in that frame.  The fields (u, v, w) and (theta_x, theta_y,
+    theta_z) are components along (t, d2, d3).  None (the default) is the straight axis with gravity along -z."""
+
+    curvature: tuple
+    down: tuple
+
+
+@dataclass(frozen=True)
 class BeamProperties:
     """Everything the beam forms need, in SI units.
 
@@ -51,6 +62,7 @@ class BeamProperties:
     gravity: float
     lateral_added_mass: float = 0.0  # fluid moving with the lateral motion (v, w) [kg/m]
     lateral_fluid_damping: float = 0.0  # viscous force per length and lateral velocity [N s/m^2]
+    axis: CurvedAxis | None = field(default=None, compare=False)  # a well's axis; None: straight, horizontal
 
     @property
     def section(self) -> SectionConstants:

@@ -13,6 +13,7 @@ deflection, where the membrane strain u' + (v'^2 + w'^2)/2 must be able to vanis
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import cached_property
 
 import basix.ufl
@@ -21,7 +22,9 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from fenics_drill.forms import FIELD_NAMES, BeamProperties
+from fenics_drill.forms.properties import CurvedAxis
 from fenics_drill.model.resources import check_memory
+from fenics_drill.model.well import Trajectory, well_of
 from fenics_drill.scene import SceneError
 
 #: Index of each field in the mixed space, in the paper's order (the one place they are declared).
@@ -48,35 +51,56 @@ class BeamDiscretization:
     """The interval mesh [0, L], the mixed space and the dofs of each field (serial, COMM_SELF)."""
 
     def __init__(self, properties: BeamProperties, elements: int, element_degree: int = 2, supports: str = "paper",
-                 stabilisers: tuple = ()):
-        """``stabilisers``: x of pinned lateral supports inside the string (v = w = 0 at the nearest vertex)."""
+                 stabilisers: tuple = (), trajectory: Trajectory | None = None):
+        """``stabilisers``: x of pinned lateral supports inside the string (v = w = 0 at the nearest vertex);
+        ``trajectory``: the well's axis the string lies along from its top (x = measured depth), or None for the
+        straight horizontal hole."""
         if supports not in SUPPORTS:
             raise ValueError(f"unknown supports {supports!r}; expected one of {', '.join(SUPPORTS)}")
-        self.properties = properties
         self.elements = elements
         self.element_degree = element_degree
         self.supports = supports
         self.stabilisers = tuple(stabilisers)
         self.comm = MPI.COMM_SELF
-        self.mesh = mesh.create_interval(self.comm, self.elements, [0.0, self.properties.length])
+        self.mesh = mesh.create_interval(self.comm, self.elements, [0.0, properties.length])
         sub = [basix.ufl.element("Lagrange", "interval", d) for d in field_degrees(self.element_degree)]
         self.V = fem.functionspace(self.mesh, basix.ufl.mixed_element(sub))
+        self.trajectory = trajectory
+        self.properties = properties if trajectory is None else replace(properties, axis=self._axis(trajectory))
+
+    def _axis(self, trajectory: Trajectory) -> CurvedAxis:
+        """The well's axis on the mesh: its curvature in the Bishop frame at each cell's midpoint (constant along
+        each arc of the survey) and the downward vertical in the frame at each vertex, interpolated linearly."""
+        cells = fem.functionspace(self.mesh, ("DG", 0))
+        vertices = fem.functionspace(self.mesh, ("Lagrange", 1))
+        midpoints = cells.tabulate_dof_coordinates()[:, 0]
+        frames = trajectory.bishop_frames(midpoints)
+        curvature = tuple(fem.Function(cells, name=name) for name in ("k2", "k3"))
+        curvature[0].x.array[:], curvature[1].x.array[:] = frames.k2, frames.k3
+        down = trajectory.bishop_frames(vertices.tabulate_dof_coordinates()[:, 0]).down()
+        components = tuple(fem.Function(vertices, name=name) for name in ("down_t", "down_2", "down_3"))
+        for i, component in enumerate(components):
+            component.x.array[:] = down[:, i]
+        return CurvedAxis(curvature, components)
 
     @classmethod
     def from_scene(cls, scene) -> "BeamDiscretization":
         """The discretization a scene asks for (``beam.*``, ``model.supports``); refused before any
-        allocation if it does not fit in memory (:mod:`fenics_drill.model.resources`).  The beam lies in the
-        straight horizontal hole of ``beam.length`` and ``borehole.radius``: a scene that gives a survey or string
-        sections is refused (those are read by the soft-string model, ``fenics-drill torque-drag``)."""
-        given = [name for name, value in (("well.survey", scene.well.survey), ("well.md", scene.well.md),
-                                          ("well.hole_radius", scene.well.hole_radius), ("string.sections", scene.string.sections)) if value]
+        allocation if it does not fit in memory (:mod:`fenics_drill.model.resources`).  The beam lies along the
+        well's survey from the surface (``[well]``), or in the straight horizontal hole of ``beam.length``.  Its
+        section is one pipe's ([beam]) in the hole of ``borehole.radius``: string sections and hole sections are
+        refused (those are read by the soft-string model, ``fenics-drill torque-drag``)."""
+        given = [name for name, value in (("well.hole_radius", scene.well.hole_radius),
+                                          ("string.sections", scene.string.sections)) if value]
         if given:
-            raise SceneError(f"{' and '.join(given)} describe a well for 'fenics-drill torque-drag' (the soft-string "
-                             "model); the finite-element model runs the straight horizontal hole of [beam] and "
-                             "[borehole]: leave them out for run, static, modal, campbell, mc and optimize")
+            raise SceneError(f"{' and '.join(given)} describe a string or hole of several sections, which "
+                             "'fenics-drill torque-drag' (the soft-string model) reads; the finite-element model "
+                             "runs one pipe of [beam] in the hole of borehole.radius: leave them out for run, static, "
+                             "modal, campbell, mc and optimize")
         check_memory(scene.beam.elements, scene.beam.element_degree)
+        trajectory = well_of(scene, scene.beam.length).trajectory if (scene.well.survey or scene.well.md) else None
         return cls(scene.beam_properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports,
-                   scene.supports.stabilisers)
+                   scene.supports.stabilisers, trajectory)
 
     @property
     def ndofs(self) -> int:
@@ -134,6 +158,14 @@ class BeamDiscretization:
             Vi, _ = self.V.sub(i).collapse()
             x[dofs] = Vi.tabulate_dof_coordinates()[:, 0]
         return x
+
+    @cached_property
+    def element_curvature(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The axis' curvature (k2, k3) [1/m] at the midpoints between consecutive vertices (None: straight)."""
+        if self.trajectory is None:
+            return None
+        frames = self.trajectory.bishop_frames(0.5 * (self.vertex_x[1:] + self.vertex_x[:-1]))
+        return frames.k2, frames.k3
 
     @cached_property
     def vertex_x(self) -> np.ndarray:

@@ -110,7 +110,7 @@ class InternalForms:
             return weight * (density - linear_density if sampled else density) * dx
 
         kinetic = energies.kinetic_energy_density(p, U, V, inertial_nonlinearity, angular_velocity)
-        strain = energies.strain_energy_density(p, energies.strain_slots(U), geometric_nonlinearity, kinematics)
+        strain = energies.strain_energy_density(p, energies.strain_slots(U, p.axis), geometric_nonlinearity, kinematics)
         if not sampled:
             residual = (inertial(inertial_nonlinearity) + elastic(geometric_nonlinearity)
                         + energies.damping_force(p, psi, V, dx))
@@ -120,7 +120,7 @@ class InternalForms:
                                                                         (elastic, geometric_nonlinearity)) if on]
             residual = sum(remainders[1:], remainders[0])
         self.kinetic = fem.form(energy(kinetic, energies.kinetic_energy_density(p, U, V, False)))
-        self.strain = fem.form(energy(strain, energies.strain_energy_density(p, energies.strain_slots(U), False)))
+        self.strain = fem.form(energy(strain, energies.strain_energy_density(p, energies.strain_slots(U, p.axis), False)))
         self.residual = fem.form(residual)
         # one form per derivative df/dq, df/dqd, df/dqdd (None where the residual does not hold the field): each
         # part is assembled by a kernel of its own, not by the whole Jacobian's kernel with two coefficients zero.

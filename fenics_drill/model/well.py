@@ -162,6 +162,65 @@ class Trajectory:
         """Inclination from the vertical [rad] at measured depths ``s``."""
         return np.arccos(np.clip(-self.tangents(s)[:, 2], -1.0, 1.0))
 
+    def bishop_frames(self, s) -> "AxisFrames":
+        """The twist-free (Bishop) frame of the axis at measured depths ``s``, and the axis' curvature in it.
+
+        At the surface d3 is the high side (the azimuth's direction where the hole starts vertical) and
+        d2 = d3 x t; down-hole the frame is carried by parallel transport: along each arc it turns with the
+        tangent about the arc's binormal b, by beta s / length, so that t' = k2 d2 + k3 d3, d2' = -k2 t,
+        d3' = -k3 t with (k2, k3) = kappa ((b x t).d2, (b x t).d3), constant along the arc."""
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        binormals = np.cross(self.t[:-1], self.t[1:])
+        norms = np.linalg.norm(binormals, axis=1)
+        binormals = np.where(norms[:, None] > 1e-12, binormals / np.where(norms > 1e-12, norms, 1.0)[:, None], 0.0)
+        d3 = [_high_side(self.t[0], self.survey.azimuth[0])]
+        for k, beta in enumerate(self.beta):  # the frame at each station, carried along the arcs
+            d3.append(_rotated(d3[-1], binormals[k], beta)[0])
+        d3 = np.array(d3)
+        k = self._segment(s)
+        share = np.clip((s - self.md[k]) / (self.md[k + 1] - self.md[k]), 0.0, 1.0)
+        t = self.tangents(s)
+        d3_s = _rotated(d3[k], binormals[k], share * self.beta[k])
+        d3_s -= np.einsum("ij,ij->i", d3_s, t)[:, None] * t  # round-off only: d3 is normal to t
+        d3_s /= np.linalg.norm(d3_s, axis=1)[:, None]
+        d2_s = np.cross(d3_s, t)
+        normal = self.curvature(s)[:, None] * np.cross(binormals[k], t)
+        return AxisFrames(t, d2_s, d3_s, np.einsum("ij,ij->i", normal, d2_s), np.einsum("ij,ij->i", normal, d3_s))
+
+
+@dataclass(frozen=True)
+class AxisFrames:
+    """Bishop frames (t, d2, d3) of the axis at some measured depths (rows, in north-east-up), and the curvature
+    components (k2, k3) [1/m] of the axis in them."""
+
+    t: np.ndarray
+    d2: np.ndarray
+    d3: np.ndarray
+    k2: np.ndarray
+    k3: np.ndarray
+
+    def down(self) -> np.ndarray:
+        """The unit downward vertical in each frame: its components along (t, d2, d3), one row per depth."""
+        return -np.stack([self.t[:, 2], self.d2[:, 2], self.d3[:, 2]], axis=1)
+
+
+def _high_side(t: np.ndarray, azimuth: float) -> np.ndarray:
+    """The unit vector normal to t toward the vertical's up (the hole's high side); where t is vertical, the
+    horizontal direction of ``azimuth`` (the high side the hole will have once it builds that way)."""
+    up = np.array([0.0, 0.0, 1.0]) - t[2] * t
+    norm = np.linalg.norm(up)
+    if norm > 1e-9:
+        return up / norm
+    return np.array([np.cos(azimuth), np.sin(azimuth), 0.0])
+
+
+def _rotated(vectors: np.ndarray, axes: np.ndarray, angles) -> np.ndarray:
+    """Rodrigues' rotation of ``vectors`` about the unit ``axes`` (zero: no rotation) by ``angles`` (rows)."""
+    vectors, axes = np.atleast_2d(vectors), np.atleast_2d(axes)
+    angles = np.broadcast_to(np.asarray(angles, dtype=float), (max(len(vectors), len(axes)),))[:, None]
+    along = np.einsum("ij,ij->i", axes, vectors)[:, None] * axes
+    return vectors * np.cos(angles) + np.cross(axes, vectors) * np.sin(angles) + along * (1 - np.cos(angles))
+
 
 def straight_survey(length: float, inclination_deg: float = 90.0, azimuth_deg: float = 0.0) -> Survey:
     """A straight hole of ``length`` at a fixed inclination and azimuth (the paper's: horizontal)."""

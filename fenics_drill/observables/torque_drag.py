@@ -2,7 +2,7 @@
 per length, from a state's vertex values; the force and torque the drive applies at the top, from the series.
 
 Along each element between two vertices the axial force is E A eps with the Green-Lagrange stretch
-eps = u' + (v'^2 + w'^2) / 2 and the torque the model's torsional stiffness kappa_s G (2 I4) times theta_x', from
+eps = u' + (v'^2 + w'^2) / 2 (on a well's curved axis, u' - k2 v - k3 w in the axis' frame) and the torque the model's torsional stiffness kappa_s G (2 I4) times theta_x', from
 the vertex values (the element's mean strain); the wall's normal force at a vertex is its spring force
 k_FS1 delta + k_FS2 delta^3 (Eq. 17 without the damper) over the length the vertex stands for.
 """
@@ -13,13 +13,21 @@ import numpy as np
 
 
 def string_profiles(x, u, v, w, theta_x, properties, gap: float, stiffness_linear: float,
-                    stiffness_cubic: float) -> dict[str, np.ndarray]:
+                    stiffness_cubic: float, theta_y=None, theta_z=None,
+                    curvature: tuple | None = None) -> dict[str, np.ndarray]:
     """``axial_force`` [N] (tension positive) and ``torque`` [N m] on the elements between consecutive vertices
-    (sorted along x), and ``wall_normal_force_per_length`` [N/m] at the vertices."""
+    (sorted along x), and ``wall_normal_force_per_length`` [N/m] at the vertices.  On a curved axis,
+    ``curvature`` (k2, k3) on each element: the derivatives are the frame's, u' - k2 v - k3 w and
+    theta_x' - k2 theta_y - k3 theta_z with the element's mean v, w, theta_y, theta_z."""
     order = np.argsort(x)
     x, u, v, w, theta_x = (np.asarray(a, dtype=float)[order] for a in (x, u, v, w, theta_x))
     h = np.diff(x)
     du, dv, dw, dt = (np.diff(a) / h for a in (u, v, w, theta_x))
+    if curvature is not None:
+        k2, k3 = curvature
+        mean = lambda a: 0.5 * (a[1:] + a[:-1])  # noqa: E731
+        du = du - k2 * mean(v) - k3 * mean(w)
+        dt = dt - k2 * mean(np.asarray(theta_y)[order]) - k3 * mean(np.asarray(theta_z)[order])
     s = properties.section
     axial = properties.young_modulus * s.area * (du + 0.5 * (dv**2 + dw**2))
     torque = properties.shear_factor * properties.shear_modulus * 2.0 * s.I4 * dt
@@ -30,12 +38,14 @@ def string_profiles(x, u, v, w, theta_x, properties, gap: float, stiffness_linea
 
 
 def top_loads(time, lambda_1, lambda_4) -> dict:
-    """The force and torque the drive applies at the top (-lambda_1, -lambda_4), at the end and averaged over the
-    second half of the run."""
+    """The force and torque the drive applies at the top (-lambda_1, -lambda_4; the force along x, down-hole) and
+    the hook load (lambda_1: what the top holds up, the force's opposite), at the end and averaged over the second
+    half of the run."""
     time = np.asarray(time, dtype=float)
     half = int(np.searchsorted(time, 0.5 * (time[0] + time[-1])))
     weights = np.gradient(time[half:]) if time.size - half > 1 else np.ones(time.size - half)
     out = {}
-    for name, series in (("top_axial_force", -np.asarray(lambda_1)), ("surface_torque", -np.asarray(lambda_4))):
+    for name, series in (("top_axial_force", -np.asarray(lambda_1)), ("hook_load", np.asarray(lambda_1)),
+                         ("surface_torque", -np.asarray(lambda_4))):
         out[name] = {"last": float(series[-1]), "mean_second_half": float(np.average(series[half:], weights=weights))}
     return out

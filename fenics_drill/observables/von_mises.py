@@ -197,7 +197,7 @@ class VonMisesProbe:
         p = disc.properties
         self.E, self.G = p.young_modulus, p.shear_modulus
         self.field = fem.Function(disc.V)
-        slots = strain_slots(self.field)
+        slots = strain_slots(self.field, p.axis)
         strains = green_lagrange_strains(slots, kinematics) if geometric_nonlinearity else linear_strains(slots)
         coefficients = [poly.terms.get(m, 0.0) for poly in strains for m in MONOMIALS]
         expression = ufl.as_vector([c if isinstance(c, ufl.core.expr.Expr) else ufl.as_ufl(c) for c in coefficients])
@@ -255,7 +255,7 @@ class VonMisesProbe:
         bound of the stress reaches the stress sampled at the section of largest bound."""
         expressions = tuple((e.address, e.cell_dofs, e.constants, e.coordinates, e.size)
                             for e in (self._at_element_ends, self._at_end_cells))
-        squared, at = _batch_maxima(*expressions, np.ascontiguousarray(dofs_rows, dtype=float), self.monomials,
+        squared, at = _batch_maxima(*expressions, self._at_element_ends.with_fixed(dofs_rows), self.monomials,
                                     self.monomial_bounds, self.outer_radius, self.E, self.G,
                                     self._end_midpoints)
         return np.sqrt(squared), self._point_x[at]

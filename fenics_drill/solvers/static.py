@@ -119,7 +119,8 @@ def _newton(model: DrillstringModel, q, mu, tolerance: float, max_iterations: in
 
 
 def static_report(model: DrillstringModel, eq: StaticEquilibrium) -> dict:
-    """max_sag [m], contact vertices and forces: what ``fenics-drill static`` writes to static.json."""
+    """max_sag [m], the hook load [N], contact vertices and forces: what ``fenics-drill static`` writes to
+    static.json."""
     v, w = (rows @ eq.q for rows in model.lateral_rows)
     x = model.disc.vertex_x
     p = model.disc.properties
@@ -129,6 +130,9 @@ def static_report(model: DrillstringModel, eq: StaticEquilibrium) -> dict:
         "max_lateral_displacement": float(np.max(np.hypot(v, w))),
         "gap": model.gap,
         "weight": p.density * p.section.area * p.gravity * p.length,
+        # the top holds the string (both drive dofs, :func:`solve_static`): the load it applies along the axis,
+        # down-hole > 0, is minus the hook load
+        "hook_load": -model.at_rest().drive.applied(eq.mu, None)[0],
         "newton_iterations": eq.iterations,
         "relative_residual": eq.residual,
         "contact_vertices": [],

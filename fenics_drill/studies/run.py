@@ -22,7 +22,7 @@ from fenics_drill.io.fields import FieldWriter
 from fenics_drill.io.files import no_room_message, write_final_json, write_json
 from fenics_drill.io.output_directory import claim_output, remove_figures
 from fenics_drill.io.timeseries import TimeSeriesWriter, read_series
-from fenics_drill.model.discretization import THETA_X, U, V, W
+from fenics_drill.model.discretization import THETA_X, THETA_Y, THETA_Z, U, V, W
 from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.model.reduction.modes import drive_held_modes
 from fenics_drill.model.resources import check_disk, check_memory
@@ -178,8 +178,9 @@ class RunRecorder:
             dofs = self.model.space.expand(state.q)
             stress = self.rows.stress.cell_stress(dofs) if self.rows.stress is not None else None
             disc = self.model.disc
-            u, v, w, tx = (dofs[disc.vertex_dofs(f)] for f in (U, V, W, THETA_X))
-            profiles = string_profiles(disc.vertex_x, u, v, w, tx, disc.properties, *self.profile_law)
+            u, v, w, tx, ty, tz = (dofs[disc.vertex_dofs(f)] for f in (U, V, W, THETA_X, THETA_Y, THETA_Z))
+            profiles = string_profiles(disc.vertex_x, u, v, w, tx, disc.properties, *self.profile_law, ty, tz,
+                                       disc.element_curvature)
             self.fields.write(dofs, state.t, stress, profiles)
             self.next_field_time = self.field_interval * (np.floor(state.t / self.field_interval + 1e-9) + 1)
 

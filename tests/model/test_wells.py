@@ -94,7 +94,7 @@ def test_a_scene_relates_its_string_and_its_well_or_says_why_not(tmp_path):
         scene(sections=[dict(PIPE, inner_radius=0.07)])
     with pytest.raises(SceneError, match="unknown key string.sections\\[1\\].od"):
         scene(sections=[dict(PIPE, od=0.1)])
-    with pytest.raises(SceneError, match="finite-element model runs the straight horizontal hole"):
+    with pytest.raises(SceneError, match="the finite-element model runs one pipe of \\[beam\\]"):
         BeamDiscretization.from_scene(s)
 
 

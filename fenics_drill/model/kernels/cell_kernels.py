@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import cffi
 import numpy as np
+import ufl
 from dolfinx import fem
 from llvmlite import ir
 from numba import njit, types
@@ -211,26 +212,49 @@ def _cell_coordinates(mesh, cells: np.ndarray) -> np.ndarray:
 
 class CellExpression:
     """A ``dolfinx.fem.Expression`` of one function (block size 1) at every cell (or at some), from the
-    function's dof values: what ``Expression.eval`` gives, without packing the coefficients through DOLFINx."""
+    function's dof values: what ``Expression.eval`` gives, without packing the coefficients through DOLFINx.
+    The expression's other coefficients (a curved axis' curvature) are fixed: their values are appended to the
+    function's (:meth:`with_fixed`), and each cell gathers them as it gathers the function's."""
 
     def __init__(self, expression: fem.Expression, function: fem.Function, cells: np.ndarray | None = None):
         """``cells``: the local cells to evaluate it at, in this order (default: all)."""
         ufcx = expression._ufcx_expression
-        if ufcx.num_coefficients != 1 or function.function_space.dofmap.bs != 1:
-            raise ValueError("CellExpression takes an expression of one function of block size 1")
+        coefficients = ufl.algorithms.extract_coefficients(expression.ufl_expression)  # in the packing's order
+        if function not in coefficients or any(c.function_space.dofmap.bs != 1 for c in coefficients):
+            raise ValueError("CellExpression takes an expression of one function and fixed coefficients, all of "
+                             "block size 1")
+        assert ufcx.num_coefficients == len(coefficients)
         self.address = int(_FFI.cast("uintptr_t", ufcx.tabulate_tensor_float64))
         mesh = function.function_space.mesh
         if cells is None:
             cells = np.arange(mesh.topology.index_map(mesh.topology.dim).size_local, dtype=np.int32)
         self.coordinates = _cell_coordinates(mesh, cells)
-        self.cell_dofs = np.ascontiguousarray(function.function_space.dofmap.list[cells])
+        blocks, fixed, offset = [], [], function.x.array.size
+        for c in coefficients:
+            dofs = c.function_space.dofmap.list[cells]
+            if c is function:
+                blocks.append(dofs)
+            else:
+                blocks.append(dofs + offset)
+                fixed.append(c.x.array.copy())
+                offset += c.x.array.size
+        self.cell_dofs = np.ascontiguousarray(np.hstack(blocks))
+        self.fixed = np.concatenate(fixed) if fixed else np.empty(0)
         self.constants = np.ascontiguousarray(fem.pack_constants(expression), dtype=float)
         self.size = expression.X().shape[0] * int(np.prod(expression.value_shape, dtype=int))
 
+    def with_fixed(self, dofs: np.ndarray) -> np.ndarray:
+        """The function's dof values (a vector, or states in rows) followed by the fixed coefficients'."""
+        dofs = np.asarray(dofs, dtype=float)
+        if not self.fixed.size:
+            return np.ascontiguousarray(dofs)
+        fixed = np.broadcast_to(self.fixed, dofs.shape[:-1] + self.fixed.shape)
+        return np.ascontiguousarray(np.concatenate((dofs, fixed), axis=-1))
+
     def __call__(self, dofs: np.ndarray) -> np.ndarray:
         """The expression at its points of each of its cells (cells x points * values)."""
-        return _expression_at_cells(self.address, np.ascontiguousarray(dofs, dtype=float), self.cell_dofs,
-                                    self.constants, self.coordinates, self.size)
+        return _expression_at_cells(self.address, self.with_fixed(dofs), self.cell_dofs, self.constants,
+                                    self.coordinates, self.size)
 
 
 class CellAssembly:
