@@ -306,6 +306,7 @@ def _execute(args) -> int:
 
     from fenics_drill.io.files import no_room_message
     from fenics_drill.io.study_directory import RankStopped
+    from fenics_drill.solvers.static import StaticFailure
 
     comm = MPI.COMM_WORLD
     where = f" (rank {comm.rank} of {comm.size})" if comm.size > 1 else ""
@@ -317,6 +318,11 @@ def _execute(args) -> int:
         if comm.size > 1 and not isinstance(err, _collective_errors()):
             comm.Abort(2)
         return 2
+    except StaticFailure as err:  # no equilibrium: the study says so and ends, no traceback
+        _say(f"fenics-drill{where}: {err}")
+        if comm.size > 1:
+            comm.Abort(1)
+        return 1
     except KeyboardInterrupt:
         _say(f"fenics-drill{where}: interrupted")
         return 130

@@ -261,7 +261,7 @@ class Uncertainty:
     output_interval: float = _pos("step of the common time grid of the Monte Carlo histories [s]", 0.01)
 
 
-_GRID = "[min, max, n] with 0 <= min <= max and n a whole number in [1, 1000]"
+_GRID = "[min, max, n] with 0 <= min <= max and n a whole number in [1, 1000] (n = 1: min = max)"
 
 #: Most realisations a study takes (per grid point for ``optimize``): each is a run and a file, and
 #: the statistics (101) of 10^4 are converged far beyond what the bit-rock data support.
@@ -455,17 +455,26 @@ class Scene:
         return self.model.laws if choice == "model" else choice
 
     @property
+    def string_length(self) -> float:
+        """The string's length [m]: its sections' (``string.sections``), or ``beam.length``."""
+        sections = self.string.sections
+        return float(sum(section["length"] for section in sections)) if sections else self.beam.length
+
+    @property
     def beam_properties(self) -> BeamProperties:
-        """The parameter object the forms take (gravity 0 when ``model.gravity`` is off)."""
+        """The parameter object the forms take (gravity 0 when ``model.gravity`` is off); its length is the
+        string's (:attr:`string_length`)."""
         b = self.beam
         return BeamProperties(
-            length=b.length, outer_radius=b.outer_radius, inner_radius=b.inner_radius, density=b.density,
+            length=self.string_length, outer_radius=b.outer_radius, inner_radius=b.inner_radius, density=b.density,
             young_modulus=b.young_modulus, poisson_ratio=b.poisson_ratio, shear_factor=b.shear_factor,
             damping=b.damping, gravity=self.environment.gravity * self.buoyancy_factor if self.model.gravity else 0.0,
             lateral_added_mass=self.lateral_added_mass, lateral_fluid_damping=self.fluid.lateral_damping,
         )
 
-    def _inner_fluid_density(self) -> float:
+    @property
+    def inner_fluid_density(self) -> float:
+        """The density of the fluid inside the pipe [kg/m^3] (``fluid.inner_density``, -1: the mud's)."""
         return self.fluid.density if self.fluid.inner_density == -1.0 else self.fluid.inner_density
 
     @property
@@ -474,10 +483,14 @@ class Scene:
         rho_i pi r^2, and the mud outside, C_a rho_m pi R^2, with C_a = (R_h^2 + R^2) / (R_h^2 - R^2) of a
         cylinder in a concentric annulus of radius R_h (potential flow; Chen, Wambsganss & Jendrzejczyk 1976)
         unless ``fluid.added_mass_coefficient`` gives it."""
-        b, fluid = self.beam, self.fluid
-        hole2, pipe2 = self.borehole.radius**2, b.outer_radius**2
+        return self.lateral_added_mass_of(self.beam.outer_radius, self.beam.inner_radius, self.borehole.radius)
+
+    def lateral_added_mass_of(self, outer_radius, inner_radius, hole_radius):
+        """:attr:`lateral_added_mass` of a pipe of these radii in a hole of ``hole_radius`` (numbers or arrays)."""
+        fluid = self.fluid
+        hole2, pipe2 = hole_radius**2, outer_radius**2
         c_a = (hole2 + pipe2) / (hole2 - pipe2) if fluid.added_mass_coefficient == -1.0 else fluid.added_mass_coefficient
-        return math.pi * (self._inner_fluid_density() * b.inner_radius**2 + c_a * fluid.density * pipe2)
+        return math.pi * (self.inner_fluid_density * inner_radius**2 + c_a * fluid.density * pipe2)
 
     @property
     def buoyancy_factor(self) -> float:
@@ -485,7 +498,7 @@ class Scene:
         on the fluid outside and inside; 1 in air).  The FE model's gravity load (52) is scaled by it."""
         b = self.beam
         steel = b.outer_radius**2 - b.inner_radius**2
-        return 1.0 + (self._inner_fluid_density() * b.inner_radius**2 - self.fluid.density * b.outer_radius**2) / (
+        return 1.0 + (self.inner_fluid_density * b.inner_radius**2 - self.fluid.density * b.outer_radius**2) / (
             b.density * steel)
 
 

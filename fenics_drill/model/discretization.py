@@ -13,19 +13,21 @@ deflection, where the membrane strain u' + (v'^2 + w'^2)/2 must be able to vanis
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from functools import cached_property
 
 import basix.ufl
 import numpy as np
+import ufl
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from fenics_drill.forms import FIELD_NAMES, BeamProperties
 from fenics_drill.forms.properties import CurvedAxis
 from fenics_drill.model.resources import check_memory
+from fenics_drill.model.string_sections import fe_sections, string_sections
 from fenics_drill.model.well import Trajectory, well_of
-from fenics_drill.scene import SceneError
 
 #: Index of each field in the mixed space, in the paper's order (the one place they are declared).
 U, V, W, THETA_X, THETA_Y, THETA_Z = range(6)
@@ -47,36 +49,105 @@ def field_degrees(element_degree: int) -> tuple[int, ...]:
     return (k, k, k, k - 1, k - 1, k - 1)
 
 
+def mesh_vertices(length: float, elements: int, breaks) -> np.ndarray:
+    """Vertices on [0, length] about ``length / elements`` apart that fall on every break inside it: each interval
+    between consecutive breaks is cut into equal elements no longer than that (so there are at least
+    ``elements``)."""
+    h = length / elements
+    points = np.unique(np.clip(np.array([0.0, length, *breaks], dtype=float), 0.0, length))
+    points = points[np.concatenate([[True], np.diff(points) > 1e-9 * length])]  # breaks closer than round-off: one
+    points[-1] = length
+    pieces = [np.linspace(a, b, max(1, math.ceil((b - a) / h - 1e-9)) + 1)[:-1] for a, b in zip(points[:-1], points[1:])]
+    return np.concatenate([*pieces, [length]])
+
+
 class BeamDiscretization:
     """The interval mesh [0, L], the mixed space and the dofs of each field (serial, COMM_SELF)."""
 
     def __init__(self, properties: BeamProperties, elements: int, element_degree: int = 2, supports: str = "paper",
-                 stabilisers: tuple = (), trajectory: Trajectory | None = None):
+                 stabilisers: tuple = (), trajectory: Trajectory | None = None, sections=None, breaks: tuple = ()):
         """``stabilisers``: x of pinned lateral supports inside the string (v = w = 0 at the nearest vertex);
         ``trajectory``: the well's axis the string lies along from its top (x = measured depth), or None for the
-        straight horizontal hole."""
+        straight horizontal hole; ``sections``: None for one pipe (``properties``), or what the string is made of
+        along x, ``sections(cell midpoints, vertex x)`` -> :class:`~fenics_drill.model.string_sections.FESections`
+        (``properties`` then holds the section at the bit, for what needs one number); ``breaks``: x where a
+        vertex must fall (the ends of sections and of the survey's arcs: :func:`mesh_vertices`)."""
         if supports not in SUPPORTS:
             raise ValueError(f"unknown supports {supports!r}; expected one of {', '.join(SUPPORTS)}")
-        self.elements = elements
         self.element_degree = element_degree
         self.supports = supports
         self.stabilisers = tuple(stabilisers)
         self.comm = MPI.COMM_SELF
-        self.mesh = mesh.create_interval(self.comm, self.elements, [0.0, properties.length])
+        if breaks:
+            x = mesh_vertices(properties.length, elements, breaks)
+            cells = np.stack([np.arange(x.size - 1), np.arange(1, x.size)], axis=1).astype(np.int64)
+            line = ufl.Mesh(basix.ufl.element("Lagrange", "interval", 1, shape=(1,)))
+            self.mesh = mesh.create_mesh(self.comm, cells, line, x[:, None])
+        else:
+            self.mesh = mesh.create_interval(self.comm, elements, [0.0, properties.length])
+        self.elements = self.mesh.topology.index_map(1).size_local
         sub = [basix.ufl.element("Lagrange", "interval", d) for d in field_degrees(self.element_degree)]
         self.V = fem.functionspace(self.mesh, basix.ufl.mixed_element(sub))
         self.trajectory = trajectory
         self.properties = properties if trajectory is None else replace(properties, axis=self._axis(trajectory))
+        self.sections = None
+        #: What the forms take: :attr:`properties`, with each section's values on its cells for a string of sections.
+        self.form_properties = self.properties
+        if sections is not None:
+            cell_x = self.cell_space.tabulate_dof_coordinates()[:, 0]
+            self.sections = sections(cell_x, self.vertex_x)
+            cells = self.sections.cells
+            bit = int(np.argmax(cell_x))
+            self.properties = replace(self.properties, **{name: float(values[bit]) for name, values in cells.items()})
+            self.form_properties = replace(self.properties, **{name: self._cell_function(name, values)
+                                                               for name, values in cells.items()})
+
+    def vertex_radii(self, borehole_radius: float) -> tuple[np.ndarray, np.ndarray]:
+        """(contact radius, hole radius) [m] at each vertex: the pipe's outer radius in ``borehole_radius``, or the
+        string's and the well's sections."""
+        if self.sections is not None:
+            return self.sections.contact_radius, self.sections.hole_radius
+        n = len(self.vertex_x)
+        return np.full(n, self.properties.outer_radius), np.full(n, borehole_radius)
+
+    def vertex_gap(self, borehole_radius: float) -> np.ndarray:
+        """The radial clearance between the pipe and the hole at each vertex [m] (:meth:`vertex_radii`)."""
+        contact_radius, hole_radius = self.vertex_radii(borehole_radius)
+        return hole_radius - contact_radius
+
+    @cached_property
+    def element_properties(self) -> BeamProperties:
+        """:attr:`properties`, with one value per element between consecutive vertices (along x) for a string of
+        sections (what reading a state's axial force and torque needs)."""
+        if self.sections is None:
+            return self.properties
+        order = np.argsort(self.cell_space.tabulate_dof_coordinates()[:, 0])
+        return replace(self.properties, **{name: values[order] for name, values in self.sections.cells.items()})
+
+    @property
+    def weight(self) -> float:
+        """The string's weight (in the fluids) [N]: rho A g over its length, section by section."""
+        p = self.element_properties
+        if self.sections is None:
+            return p.density * p.section.area * p.gravity * p.length
+        return float(np.sum(p.density * p.section.area * p.gravity * np.diff(self.vertex_x)))
+
+    @cached_property
+    def cell_space(self) -> fem.FunctionSpace:
+        """The piecewise-constant space: one value per cell."""
+        return fem.functionspace(self.mesh, ("DG", 0))
+
+    def _cell_function(self, name: str, values: np.ndarray) -> fem.Function:
+        function = fem.Function(self.cell_space, name=name)
+        function.x.array[:] = values
+        return function
 
     def _axis(self, trajectory: Trajectory) -> CurvedAxis:
         """The well's axis on the mesh: its curvature in the Bishop frame at each cell's midpoint (constant along
         each arc of the survey) and the downward vertical in the frame at each vertex, interpolated linearly."""
-        cells = fem.functionspace(self.mesh, ("DG", 0))
         vertices = fem.functionspace(self.mesh, ("Lagrange", 1))
-        midpoints = cells.tabulate_dof_coordinates()[:, 0]
-        frames = trajectory.bishop_frames(midpoints)
-        curvature = tuple(fem.Function(cells, name=name) for name in ("k2", "k3"))
-        curvature[0].x.array[:], curvature[1].x.array[:] = frames.k2, frames.k3
+        frames = trajectory.bishop_frames(self.cell_space.tabulate_dof_coordinates()[:, 0])
+        curvature = (self._cell_function("k2", frames.k2), self._cell_function("k3", frames.k3))
         down = trajectory.bishop_frames(vertices.tabulate_dof_coordinates()[:, 0]).down()
         components = tuple(fem.Function(vertices, name=name) for name in ("down_t", "down_2", "down_3"))
         for i, component in enumerate(components):
@@ -86,21 +157,23 @@ class BeamDiscretization:
     @classmethod
     def from_scene(cls, scene) -> "BeamDiscretization":
         """The discretization a scene asks for (``beam.*``, ``model.supports``); refused before any
-        allocation if it does not fit in memory (:mod:`fenics_drill.model.resources`).  The beam lies along the
-        well's survey from the surface (``[well]``), or in the straight horizontal hole of ``beam.length``.  Its
-        section is one pipe's ([beam]) in the hole of ``borehole.radius``: string sections and hole sections are
-        refused (those are read by the soft-string model, ``fenics-drill torque-drag``)."""
-        given = [name for name, value in (("well.hole_radius", scene.well.hole_radius),
-                                          ("string.sections", scene.string.sections)) if value]
-        if given:
-            raise SceneError(f"{' and '.join(given)} describe a string or hole of several sections, which "
-                             "'fenics-drill torque-drag' (the soft-string model) reads; the finite-element model "
-                             "runs one pipe of [beam] in the hole of borehole.radius: leave them out for run, static, "
-                             "modal, campbell, mc and optimize")
+        allocation if it does not fit in memory (:mod:`fenics_drill.model.resources`).  The string lies along the
+        well's survey from the surface (``[well]``), or in the straight horizontal hole of ``beam.length``.  It is the
+        one pipe of [beam] in the hole of ``borehole.radius``, or the sections of ``string.sections`` (their length
+        is the string's) in the hole sections of ``[well]``."""
         check_memory(scene.beam.elements, scene.beam.element_degree)
-        trajectory = well_of(scene, scene.beam.length).trajectory if (scene.well.survey or scene.well.md) else None
-        return cls(scene.beam_properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports,
-                   scene.supports.stabilisers, trajectory)
+        sectioned = bool(scene.string.sections or scene.well.hole_radius)
+        if not (sectioned or scene.well.survey or scene.well.md):
+            return cls(scene.beam_properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports,
+                       scene.supports.stabilisers)
+        strings = string_sections(scene)
+        well = well_of(scene, strings[-1].bottom)
+        properties = replace(scene.beam_properties, length=strings[-1].bottom)
+        layout = (lambda cells, vertices: fe_sections(scene, well.hole.radius, cells, vertices)) if sectioned else None
+        trajectory = well.trajectory if (scene.well.survey or scene.well.md) else None
+        breaks = (*(s.bottom for s in strings), *well.hole.bottoms, *(well.trajectory.md if trajectory else ()))
+        return cls(properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports,
+                   scene.supports.stabilisers, trajectory, layout, breaks)
 
     @property
     def ndofs(self) -> int:

@@ -23,6 +23,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 
 from fenics_drill.model.discretization import THETA_X, U, V, W, BeamDiscretization
 from fenics_drill.model.forces import ForceEvaluation, build_forces
@@ -65,7 +66,8 @@ class DrillstringModel:
         self.scene, self.disc, self.space, self.basis = scene, disc, space, basis
         self.modes = modes  # every mode of the band B, kept or not (to name spectral peaks)
         self.guard = guard or {}  # per load: share of its static response the modes / the basis miss
-        self.gap = scene.borehole.radius - disc.properties.outer_radius
+        self.vertex_gap = disc.vertex_gap(scene.borehole.radius)  # the radial clearance at each vertex [m]
+        self.gap = float(self.vertex_gap.min())  # the smallest
         self.mass = space.project_matrix(operators.mass)
         self.internal = internal_force(disc, space, operators, scene.model)
         self.forces = build_forces(scene, disc, space, operators)
@@ -82,8 +84,10 @@ class DrillstringModel:
         self.error_rows = (*self.lateral_rows, self.bit_rows[0:1], disc.properties.outer_radius * self.bit_rows[1:2])
         # every vertex's displacements (u, v, w) and surface arc r theta_x [m]: how far an increment of q moves
         # any point of the string's surface (Newton's stopping test, solvers/newmark.py)
+        radius = disc.vertex_radii(scene.borehole.radius)[0]
+        arcs = space.rows(disc.vertex_dofs(THETA_X))
         self.motion_rows = stack_rows([*(space.rows(disc.vertex_dofs(f)) for f in (U, V, W)),
-                                       disc.properties.outer_radius * space.rows(disc.vertex_dofs(THETA_X))])
+                                       sp.diags(radius) @ arcs if sp.issparse(arcs) else radius[:, None] * arcs])
         self.operators = operators
         self.exact_internal, self.hyper_reduction, self.training_states = None, None, []  # set by with_sample
         self._kept_internal_tangent = None  # (coefficients, parts, their sum) of the last tangent

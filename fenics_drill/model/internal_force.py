@@ -91,7 +91,7 @@ class InternalForms:
 
     def __init__(self, disc: BeamDiscretization, switches: tuple, sampled: bool):
         geometric_nonlinearity, inertial_nonlinearity, kinematics, angular_velocity = switches
-        p = disc.properties
+        p = disc.form_properties
         # Energies are polynomials of degree <= 4 in the fields up to sin/cos(theta_x):
         # 2k integrates the mass exactly for v, w of degree k and keeps the kernels small.
         metadata = {"quadrature_degree": 2 * disc.element_degree}

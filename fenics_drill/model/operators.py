@@ -34,12 +34,12 @@ class LinearOperators:
 def _forms(disc: BeamDiscretization):
     U, psi = ufl.TrialFunction(disc.V), ufl.TestFunction(disc.V)
     dx = ufl.Measure("dx", domain=disc.mesh)
-    p = disc.properties
+    p, numbers = disc.form_properties, disc.properties  # what the forms take; the switches read numbers
     return (
         fem.form(mass_form(p, psi, U, dx)),
-        fem.form(damping_form(p, psi, U, dx)) if p.damping != 0 or p.lateral_fluid_damping != 0 else None,  # zero
+        fem.form(damping_form(p, psi, U, dx)) if numbers.damping != 0 or numbers.lateral_fluid_damping != 0 else None,
         fem.form(stiffness_form(p, psi, U, dx)),
-        fem.form(gravity_form(p, psi, dx)) if p.gravity != 0 else None,  # g = 0: UFL's zero form
+        fem.form(gravity_form(p, psi, dx)) if numbers.gravity != 0 else None,  # g = 0: UFL's zero form
     )
 
 

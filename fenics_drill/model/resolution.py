@@ -11,6 +11,9 @@ paper's string against 1000 elements (``python benchmarks/mesh_resolution.py``):
 from __future__ import annotations
 
 import math
+from dataclasses import replace
+
+from fenics_drill.model.string_sections import string_sections
 
 #: Fewest displacement nodes (elements x degree) per flexural wavelength at f_max for the band to be carried
 #: within about 10 %.
@@ -33,10 +36,15 @@ def flexural_wavelength(properties, frequency_hz: float) -> float:
 
 
 def nodes_per_wavelength(scene) -> float:
-    """Displacement nodes of the mesh (elements x degree over the length) per flexural wavelength at f_max."""
+    """Displacement nodes of the mesh (elements x degree over the length) per flexural wavelength at f_max, in the
+    section whose wavelength is the shortest."""
     b = scene.beam
-    spacing = b.length / (b.elements * b.element_degree)
-    return flexural_wavelength(scene.beam_properties, band_frequency(scene)) / spacing
+    spacing = scene.string_length / (b.elements * b.element_degree)
+    p, f_max = scene.beam_properties, band_frequency(scene)
+    pipes = [replace(p, outer_radius=s.outer_radius, inner_radius=s.inner_radius, young_modulus=s.young_modulus,
+                     density=s.mass_per_length / (math.pi * (s.outer_radius**2 - s.inner_radius**2)))
+             for s in string_sections(scene)] if scene.string.sections else [p]
+    return min(flexural_wavelength(pipe, f_max) for pipe in pipes) / spacing
 
 
 def mesh_advice(scene) -> str | None:

@@ -88,10 +88,11 @@ def string_mesh(well: Well, sections: list[StringSection], element_length: float
 
 def soft_string(mesh: StringMesh, operation: Operation, iterations: int = 50) -> dict[str, np.ndarray]:
     """Effective tension [N] and torque [N m] at the nodes, from the bit up, and the wall's contact force per
-    length [N/m] on each element, for one operation."""
+    length [N/m] on each element with its direction (a unit vector, north-east-up; zero where the wall carries
+    nothing), for one operation."""
     n = mesh.md.size
     tension, torque = np.empty(n), np.empty(n)
-    normal = np.empty(n - 1)
+    normal, direction = np.empty(n - 1), np.zeros((n - 1, 3))
     tension[-1], torque[-1] = operation.bit_force, operation.bit_torque
     down = np.array([0.0, 0.0, -1.0])
     for k in range(n - 2, -1, -1):
@@ -117,11 +118,14 @@ def soft_string(mesh: StringMesh, operation: Operation, iterations: int = 50) ->
             if converged:
                 break
         load = f_t * a_t - f_b * a_b - weight
-        wall = float(np.linalg.norm(load - (load @ axis) * axis))
+        lateral = load - (load @ axis) * axis
+        wall = float(np.linalg.norm(lateral))
+        if wall > 0.0:
+            direction[k] = lateral / wall
         tension[k] = f_t
         torque[k] = torque[k + 1] + mu * wall * r * turning_share
         normal[k] = wall / ds
-    return {"tension": tension, "torque": torque, "wall_force_per_length": normal}
+    return {"tension": tension, "torque": torque, "wall_force_per_length": normal, "wall_force_direction": direction}
 
 
 def stretch(mesh: StringMesh, sections: list[StringSection], tension: np.ndarray, depth: np.ndarray,

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fenics_drill.forms.properties import section_constants
+from fenics_drill.scene import SceneError
 
 
 @dataclass(frozen=True)
@@ -72,3 +73,56 @@ def section_at(sections: list[StringSection], md) -> np.ndarray:
     bottoms = np.array([s.bottom for s in sections])
     return np.clip(np.searchsorted(bottoms, np.atleast_1d(np.asarray(md, dtype=float)), side="left"), 0,
                    len(sections) - 1)
+
+
+@dataclass(frozen=True)
+class FESections:
+    """The string of sections on the FE mesh (x = measured depth from the top): on each cell (at its midpoint) the
+    pipe body's radii, the density that carries the tool joints' steel, E, nu, the gravity that makes rho A g the
+    buoyed weight, the fluids' lateral added mass; at each vertex the contact radius and the hole's radius."""
+
+    cells: dict  # name -> one value per cell, the BeamProperties fields the forms take
+    contact_radius: np.ndarray  # [m], per vertex
+    hole_radius: np.ndarray  # [m], per vertex
+
+    @property
+    def gap(self) -> np.ndarray:
+        """The radial clearance at each vertex [m]."""
+        return self.hole_radius - self.contact_radius
+
+
+def fe_sections(scene, hole_radius_at, cell_x: np.ndarray, vertex_x: np.ndarray) -> FESections:
+    """The scene's string (:func:`string_sections`) on cells with midpoints ``cell_x`` and on vertices ``vertex_x``,
+    in a hole whose radius at measured depth s is ``hole_radius_at(s)``.  Tool joints are added steel spread along
+    the pipe (the density rises by the joints' share, in the translational and rotational inertia alike) and the
+    contact radius where they are; at a vertex between two sections the larger contact radius.  Raises SceneError
+    where a section does not fit the hole."""
+    sections = string_sections(scene)
+    g = scene.environment.gravity if scene.model.gravity else 0.0
+    outer_fluid, inner_fluid = scene.fluid.density, scene.inner_fluid_density
+    k = section_at(sections, cell_x)
+    body = np.array([math.pi * (s.outer_radius**2 - s.inner_radius**2) for s in sections])
+    mass = np.array([s.mass_per_length for s in sections])
+    buoyed = np.array([s.buoyed_weight(1.0, outer_fluid, inner_fluid) for s in sections])  # per unit g [kg/m]
+    outer = np.array([s.outer_radius for s in sections])
+    inner = np.array([s.inner_radius for s in sections])
+    cells = {
+        "outer_radius": outer[k], "inner_radius": inner[k], "density": (mass / body)[k],
+        "young_modulus": np.array([s.young_modulus for s in sections])[k],
+        "poisson_ratio": np.array([s.poisson_ratio for s in sections])[k],
+        "gravity": g * (buoyed / mass)[k],
+        "lateral_added_mass": scene.lateral_added_mass_of(outer[k], inner[k], hole_radius_at(cell_x)),
+    }
+    contact = np.array([s.contact_radius for s in sections])
+    length = sections[-1].bottom
+    step = 1e-9 * length
+    contact_radius = np.maximum(contact[section_at(sections, np.maximum(vertex_x - step, 0.0))],
+                                contact[section_at(sections, np.minimum(vertex_x + step, length))])
+    hole = hole_radius_at(vertex_x)
+    bad = np.flatnonzero(hole - contact_radius <= 0)
+    if bad.size:
+        i = bad[0]
+        name = sections[section_at(sections, vertex_x[i])[0]].name
+        raise SceneError(f"string section '{name}' (contact radius {contact_radius[i]:g} m) does not fit the hole of "
+                         f"radius {hole[i]:g} m at md = {vertex_x[i]:.1f} m")
+    return FESections(cells, contact_radius, hole)

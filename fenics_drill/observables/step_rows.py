@@ -70,7 +70,9 @@ class StepRows:
         disc = model.disc
         section = int(np.argmin(np.abs(disc.vertex_x - scene.output.section)))
         self.section_x = float(disc.vertex_x[section])
-        self.outer_radius = disc.properties.outer_radius
+        # the pipe's contact radius and its clearance at the section (one pipe: R_ext and R_bh - R_ext)
+        self.outer_radius = float(disc.vertex_radii(scene.borehole.radius)[0][section])
+        self.section_gap = float(model.vertex_gap[section])
         v_rows, w_rows = model.lateral_rows
         tx_rows = model.space.rows(disc.vertex_dofs(THETA_X))
         # u(L), theta_x(L), then v, w, theta_x at the section, then u(0), theta_x(0): one product gives them all

@@ -16,7 +16,8 @@ def string_profiles(x, u, v, w, theta_x, properties, gap: float, stiffness_linea
                     stiffness_cubic: float, theta_y=None, theta_z=None,
                     curvature: tuple | None = None) -> dict[str, np.ndarray]:
     """``axial_force`` [N] (tension positive) and ``torque`` [N m] on the elements between consecutive vertices
-    (sorted along x), and ``wall_normal_force_per_length`` [N/m] at the vertices.  On a curved axis,
+    (sorted along x), and ``wall_normal_force_per_length`` [N/m] at the vertices.  ``properties``' numbers may be
+    one per element (a string of sections), ``gap`` one per vertex.  On a curved axis,
     ``curvature`` (k2, k3) on each element: the derivatives are the frame's, u' - k2 v - k3 w and
     theta_x' - k2 theta_y - k3 theta_z with the element's mean v, w, theta_y, theta_z."""
     order = np.argsort(x)
@@ -31,7 +32,7 @@ def string_profiles(x, u, v, w, theta_x, properties, gap: float, stiffness_linea
     s = properties.section
     axial = properties.young_modulus * s.area * (du + 0.5 * (dv**2 + dw**2))
     torque = properties.shear_factor * properties.shear_modulus * 2.0 * s.I4 * dt
-    delta = np.hypot(v, w) - gap
+    delta = np.hypot(v, w) - (np.asarray(gap)[order] if np.ndim(gap) else gap)
     spring = np.where(delta > 0, stiffness_linear * delta + stiffness_cubic * delta**3, 0.0)
     tributary = np.concatenate([[h[0] / 2], 0.5 * (h[1:] + h[:-1]), [h[-1] / 2]])
     return {"axial_force": axial, "torque": torque, "wall_normal_force_per_length": spring / tributary}

@@ -190,6 +190,16 @@ def outer_fibre(outer_radius: float, angles: int = SECTION_ANGLES) -> np.ndarray
     return outer_radius * np.column_stack([np.cos(phi), np.sin(phi)])
 
 
+def _section_scales(disc: BeamDiscretization) -> list:
+    """For a string of sections, the factor of each strain coefficient (eps_xx, eps_xy, eps_xz times y^a z^b) that
+    makes the stress of the section at the bit (E, G, R_ext of :attr:`~BeamDiscretization.properties`) the cell's:
+    E_cell / E (G_cell / G for the shears) times (R_cell / R_ext)^(a + b), as UFL coefficients."""
+    p, cell = disc.properties, disc.form_properties
+    moduli = (cell.young_modulus / p.young_modulus, cell.shear_modulus / p.shear_modulus,
+              cell.shear_modulus / p.shear_modulus)
+    return [modulus * (cell.outer_radius / p.outer_radius) ** (a + b) for modulus in moduli for a, b in MONOMIALS]
+
+
 class VonMisesProbe:
     """Maximum von Mises stress over the cross-sections of a displacement field."""
 
@@ -200,6 +210,8 @@ class VonMisesProbe:
         slots = strain_slots(self.field, p.axis)
         strains = green_lagrange_strains(slots, kinematics) if geometric_nonlinearity else linear_strains(slots)
         coefficients = [poly.terms.get(m, 0.0) for poly in strains for m in MONOMIALS]
+        if disc.sections is not None:  # each cell's E, G and radius: its strains scaled to the section at the bit's
+            coefficients = [c * factor for c, factor in zip(coefficients, _section_scales(disc))]
         expression = ufl.as_vector([c if isinstance(c, ufl.core.expr.Expr) else ufl.as_ufl(c) for c in coefficients])
         self.expression = fem.Expression(expression, ELEMENT_POINTS)
         self._at_cells = CellExpression(self.expression, self.field)

@@ -34,7 +34,7 @@ _KINDS = {Gravity: GRAVITY, WallContact: WALL, BitRock: BIT_ROCK, OutOfBandDampi
 NO_WALL = (np.empty(0), np.empty((0, 4)), np.empty((0, 4, 3)), 0.0, np.empty(0), np.empty((0, 2)), np.empty((0, 4)))
 NO_BIT = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 #: The wall law's constants (:meth:`WallContact._law`'s order and types) of a model without a wall.
-NO_WALL_LAW = (0.0,) * 4 + (False,) + (0.0,) * 4 + (False,)
+NO_WALL_LAW = (np.empty(0), 0.0, 0.0, 0.0, False, 0.0, 0.0, np.empty(0), 0.0, False)
 
 
 @njit(cache=True)

@@ -27,7 +27,7 @@ IMPACT_CLEARANCE = 1e-3
 def _impacts_at(vertices, delta, in_contact, clear, per_vertex, clearance):
     """The contacts of one accepted state at the evaluated ``vertices`` (indentations ``delta``): the vertices
     whose impact began, also counted in ``per_vertex``; ``in_contact`` and ``clear`` (per vertex) updated in
-    place.  One pass over the evaluated vertices: it runs at every accepted step."""
+    place; ``clearance`` per vertex.  One pass over the evaluated vertices: it runs at every accepted step."""
     began = np.empty(vertices.size, dtype=np.int64)
     count = 0
     for k in range(vertices.size):
@@ -39,7 +39,7 @@ def _impacts_at(vertices, delta, in_contact, clear, per_vertex, clearance):
             per_vertex[i] += 1
         if touching:
             clear[i] = False
-        elif delta[k] < -clearance:
+        elif delta[k] < -clearance[i]:
             clear[i] = True
         in_contact[i] = touching
     return began[:count]
@@ -49,10 +49,10 @@ class ImpactCounter:
     """The impacts at every vertex, from the wall's evaluations at the accepted states of a run (its
     :class:`~fenics_drill.model.forces.wall_contact.WallForces`, or None without a wall)."""
 
-    def __init__(self, vertex_count: int, gap: float):
+    def __init__(self, vertex_count: int, gap):
         self.per_vertex = np.zeros(vertex_count, dtype=np.int64)
         self.in_contact = np.zeros(vertex_count, dtype=bool)  # at the last accepted state
-        self.clearance = IMPACT_CLEARANCE * gap
+        self.clearance = IMPACT_CLEARANCE * np.broadcast_to(np.asarray(gap, dtype=float), (vertex_count,)).copy()
         # whether each vertex moved clear of the wall since its last contact (one never evaluated is far)
         self._clear = np.ones(vertex_count, dtype=bool)
         self._evaluated = None  # the vertices the wall evaluated at the last accepted state
@@ -61,7 +61,7 @@ class ImpactCounter:
         """The initial state: a vertex counts as clear if the wall left it out (farther than its near
         share of the gap) or it is more than the clearance away."""
         if wall is not None:
-            self._clear[wall.vertices] = wall.delta < -self.clearance
+            self._clear[wall.vertices] = wall.delta < -self.clearance[wall.vertices]
             self.step(wall)
 
     def step(self, wall) -> np.ndarray:

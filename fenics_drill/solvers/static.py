@@ -14,7 +14,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fenics_drill.model.discretization import U, V, W
 from fenics_drill.model.drillstring import DrillstringModel
+from fenics_drill.model.soft_string import Operation, soft_string, string_mesh
+from fenics_drill.model.string_sections import string_sections
+from fenics_drill.model.well import well_of
 from fenics_drill.solvers.newton import saddle_newton
 
 #: Contact stiffness continuation: the wall springs are scaled by 10^s, s rising from FIRST_STAGE to 0 in steps
@@ -60,12 +64,60 @@ def solve_static(model: DrillstringModel, tolerance: float = 1e-8, max_iteration
     ``initial`` guess near the equilibrium (the full-order state projected on a reduced basis), one
     Newton solve with the real wall."""
     model = model.at_rest()  # both drive dofs held, whatever drives the run
-    q, mu = (np.zeros(model.size) if initial is None else initial), np.zeros(2)
     wall = model.force("wall")
+    q, mu = (np.zeros(model.size) if initial is None else initial), np.zeros(2)
     if wall is None or initial is not None:
         return _newton(model, q, mu, tolerance, max_iterations)
+    resting = resting_guess(model)
+    if resting is not None:  # a well: from the string the soft-string model lays on the wall, the real wall at once
+        return _newton(model, resting, mu, tolerance, max_iterations)
+    return _staged(model, wall, q, mu, tolerance, max_iterations)
+
+
+def resting_guess(model: DrillstringModel) -> np.ndarray | None:
+    """Where the full-order Newton starts on a well: the string laid against the wall where the soft-string model
+    at rest (:func:`~fenics_drill.model.soft_string.soft_string`, no friction) says the wall carries it, on the
+    side its wall force comes from, RESTING_PENETRATION of the clearance into the wall (its springs act from the
+    first iterate); stretched by that model's tension.  From the straight string a long well's first updates sag
+    it by kilometres and the move limit lets it creep.  None for the straight horizontal hole or a modal space."""
+    disc, scene = model.disc, model.scene
+    if disc.trajectory is None or not model.space.sparse:
+        return None
+    sections = string_sections(scene)
+    g = scene.environment.gravity if scene.model.gravity else 0.0
+    weights = [s.buoyed_weight(g, scene.fluid.density, scene.inner_fluid_density) for s in sections]
+    well = well_of(scene, sections[-1].bottom)
+    mesh = string_mesh(well, sections, float(np.diff(disc.vertex_x).min()), weights, 0.0, 0.0)
+    rest = soft_string(mesh, Operation("at rest", 0.0, 0.0, 0.0, 0.0))
+    dofs = np.zeros(disc.ndofs)
+    element = lambda x: np.clip(np.searchsorted(mesh.md, x) - 1, 0, mesh.md.size - 2)  # noqa: E731
+    for field, axis in ((V, "d2"), (W, "d3")):
+        at = disc.field_dofs[field]
+        x = disc.dof_coordinates[at]
+        k = element(x)
+        pressed = rest["wall_force_per_length"][k] > RESTING_SHARE * mesh.weight[k]
+        toward = -np.einsum("ij,ij->i", rest["wall_force_direction"][k], getattr(disc.trajectory.bishop_frames(x), axis))
+        gap = (1.0 + RESTING_PENETRATION) * np.interp(x, disc.vertex_x, model.vertex_gap)
+        dofs[at] = np.where(pressed, gap * toward, 0.0)
+    at = disc.field_dofs[U]
+    x = disc.dof_coordinates[at]
+    p = disc.element_properties
+    strain = 0.5 * (rest["tension"][1:] + rest["tension"][:-1]) / np.interp(
+        0.5 * (mesh.md[1:] + mesh.md[:-1]), 0.5 * (disc.vertex_x[1:] + disc.vertex_x[:-1]),
+        np.broadcast_to(p.young_modulus * p.section.area, (disc.vertex_x.size - 1,)))
+    dofs[at] = np.interp(x, mesh.md, np.concatenate([[0.0], np.cumsum(strain * np.diff(mesh.md))]))
+    return model.space.project(dofs)
+
+
+#: :func:`resting_guess` lays the string on the wall where the wall carries more than this share of its weight per
+#: length, that share of the clearance into the wall.
+RESTING_SHARE, RESTING_PENETRATION = 0.05, 1e-4
+
+
+def _staged(model: DrillstringModel, wall, q, mu, tolerance: float, max_iterations: int) -> StaticEquilibrium:
+    """The wall springs stiffened stage by stage from 10^FIRST_STAGE (:data:`STAGE_STEP`) to the real wall."""
     exponent, step, iterations = FIRST_STAGE, STAGE_STEP, 0
-    # the first stage starts from the straight string: it may take all the iterations it is allowed
+    # the first stage may take all the iterations it is allowed
     eq = _newton(model.with_force(wall.with_stiffness_scale(10.0 ** exponent)), q, mu, 1e-6, max_iterations)
     while True:
         q, mu, iterations = eq.q, eq.mu, iterations + eq.iterations
@@ -123,13 +175,12 @@ def static_report(model: DrillstringModel, eq: StaticEquilibrium) -> dict:
     static.json."""
     v, w = (rows @ eq.q for rows in model.lateral_rows)
     x = model.disc.vertex_x
-    p = model.disc.properties
     report = {
         "max_sag": float(np.max(-w)),
         "max_sag_position": float(x[np.argmax(-w)]),
         "max_lateral_displacement": float(np.max(np.hypot(v, w))),
         "gap": model.gap,
-        "weight": p.density * p.section.area * p.gravity * p.length,
+        "weight": model.disc.weight,
         # the top holds the string (both drive dofs, :func:`solve_static`): the load it applies along the axis,
         # down-hole > 0, is minus the hook load
         "hook_load": -model.at_rest().drive.applied(eq.mu, None)[0],

@@ -51,7 +51,7 @@ class Simulation:
                                      solver.newton_max_iterations, solver.tangent_reuse, scene.time.error_tolerance,
                                      solver.compiled_step)
         self.controller = StepController(scene, self.stepper.beta, model.error_rows)
-        self.impacts = ImpactCounter(len(model.disc.vertex_x), model.gap)
+        self.impacts = ImpactCounter(len(model.disc.vertex_x), model.vertex_gap)
         self.stats = {"steps": 0, "rejected_steps": 0, "newton_failures": 0, "newton_iterations": 0,
                       "min_dt": np.inf, "max_dt": 0.0, "forced_steps": 0, "max_penetration": 0.0,
                       "sampling_checks": 0, "max_sampling_error": 0.0, "sample_retrainings": 0}

@@ -159,14 +159,14 @@ class RunRecorder:
         held = drive_held_modes(model.disc, model.modes, scene.modal.f_star_max, model.operators.mass,
                                 model.operators.stiffness)
         self.series = TimeSeriesWriter(out / "timeseries.h5", model.disc.vertex_x, {
-            "section_x": self.section_x, "gap": model.gap, "scene": json.dumps(scene.to_dict()),
-            "reduced_size": model.size,
+            "section_x": self.section_x, "gap": self.rows.section_gap, "section_radius": self.rows.outer_radius,
+            "scene": json.dumps(scene.to_dict()), "reduced_size": model.size,
         }, model.modes, held_modes=held)
         self.field_interval = scene.output.field_interval
         self.fields = FieldWriter(model.disc, out / "fields.xdmf", with_stress=self.rows.stress is not None,
                                   with_profiles=True) if self.field_interval > 0 else None
         contact = scene.contact
-        self.profile_law = (model.gap, contact.stiffness_linear if scene.model.contact else 0.0,
+        self.profile_law = (model.vertex_gap, contact.stiffness_linear if scene.model.contact else 0.0,
                             contact.stiffness_cubic if scene.model.contact else 0.0)
         self.next_field_time = 0.0
         # the latest state taken (what an interrupted run reports): its row is in the series at the latest when
@@ -179,7 +179,7 @@ class RunRecorder:
             stress = self.rows.stress.cell_stress(dofs) if self.rows.stress is not None else None
             disc = self.model.disc
             u, v, w, tx, ty, tz = (dofs[disc.vertex_dofs(f)] for f in (U, V, W, THETA_X, THETA_Y, THETA_Z))
-            profiles = string_profiles(disc.vertex_x, u, v, w, tx, disc.properties, *self.profile_law, ty, tz,
+            profiles = string_profiles(disc.vertex_x, u, v, w, tx, disc.element_properties, *self.profile_law, ty, tz,
                                        disc.element_curvature)
             self.fields.write(dofs, state.t, stress, profiles)
             self.next_field_time = self.field_interval * (np.floor(state.t / self.field_interval + 1e-9) + 1)
@@ -358,7 +358,7 @@ def _write_final_summary(out: Path, summary: dict) -> None:
 def _judge_admissibility(summary: dict, simulation: Simulation, scene) -> None:
     """A finished run whose numbers cannot be trusted becomes "suspect", with its reasons."""
     stats = simulation.stats
-    gap = scene.borehole.radius - scene.beam.outer_radius
+    gap = simulation.model.gap  # the smallest clearance
     summary["max_penetration"] = stats["max_penetration"]
     summary["forced_steps"] = stats["forced_steps"]
     reasons = []
@@ -469,7 +469,8 @@ def quantities_of_run(series_path: Path) -> dict:
     if "section_orbit_angle" in data:  # series written before the whirl was recorded have none
         out["whirl"] = {"section": {"x": float(attrs["section_x"]), **whirl(
             data["time"], data["section_v"], data["section_w"], data["section_v_velocity"], data["section_w_velocity"],
-            data["section_theta_x_velocity"], float(attrs["gap"]), scene.beam.outer_radius)},
+            data["section_theta_x_velocity"], float(attrs["gap"]),
+            float(attrs.get("section_radius", scene.beam.outer_radius)))},
             "bit": {"direction": "none", "held": True, "why": "model.supports holds v and w at the bit"}}
     stress = data["max_von_mises"]
     if np.isfinite(stress).any():

@@ -64,8 +64,8 @@ def torque_drag_study(scene) -> dict:
         ds = np.diff(mesh.md)
         sinusoidal = (compression > f_sin) & (compression <= f_hel)
         helical = compression > f_hel
-        for name, values in loads.items():
-            profiles[f"{name}_{operation.name}"] = values
+        for name in ("tension", "torque", "wall_force_per_length"):
+            profiles[f"{name}_{operation.name}"] = loads[name]
         profiles[f"buckling_{operation.name}"] = np.where(helical, 2, np.where(sinusoidal, 1, 0))
         results[operation.name] = {
             "hook_load_N": float(loads["tension"][0]),

@@ -72,7 +72,7 @@ def test_the_force_never_exceeds_mu_fn_opposes_the_slip_and_its_tangent_is_its_d
     sliding = np.hypot(*slips.T) > 20 * 1e-5  # tanh(20) = 1 - 8e-18: the Coulomb limit
     assert magnitude[sliding] == pytest.approx(MU * np.abs(normal[sliding]), rel=1e-12)
 
-    gap, law = 0.015, (0.015, 1e10, 1e16, 1e6, False, MU, MU, 0.08, 1e-5, True)
+    gap, law = 0.015, (np.array([0.015]), 1e10, 1e16, 1e6, False, MU, MU, np.array([0.08]), 1e-5, True)
     worst = 0.0
     for _ in range(100):
         angle, indentation = rng.uniform(0, 2 * np.pi), rng.uniform(1e-7, 3e-6)

@@ -247,8 +247,8 @@ def test_fe_static_state_on_a_build_and_hold_well_matches_the_soft_string():
         assert np.abs(force[on] / tension[on] - 1.0).max() < tolerance, (a, b)
 
 
-def test_the_fe_model_refuses_string_and_hole_sections_it_does_not_model():
-    scene = scene_with(*well([0, 100], [90, 90], [0, 0]), "beam.length=100.0", "well.hole_bottom=[100.0]",
-                       "well.hole_radius=[0.1]")
-    with pytest.raises(SceneError, match="well.hole_radius"):
+def test_a_section_wider_than_its_hole_is_refused_by_the_fe_model():
+    scene = scene_with(*well([0, 100], [90, 90], [0, 0]), "well.hole_bottom=[50.0, 100.0]",
+                       "well.hole_radius=[0.1, 0.07]", "beam.length=100.0")
+    with pytest.raises(SceneError, match="does not fit the hole of radius 0.07 m at md = 5"):
         BeamDiscretization.from_scene(scene)

@@ -38,7 +38,7 @@ def test_a_vertex_left_out_cannot_reach_the_wall_while_the_bound_holds(resting):
     for _ in range(300):
         dq = rng.standard_normal(q0.size) * rng.uniform(0, 1, q0.size) ** 3
         dq *= 0.999 * near.reach / (near.column_bound @ np.abs(dq))
-        assert np.all(radii(q0 + dq) < wall.gap)
+        assert np.all(radii(q0 + dq) < wall.gap[left_out])  # each left-out vertex off the wall at its clearance
         assert wall._near_vertices(q0 + dq) is near  # inside the reach the set is kept
     # the bound is not vacuous: moving one coordinate, the vertex that decides it moves by at least
     # 1/sqrt(2) of the bound (|(a, b)|_2 >= |(a, b)|_1 / sqrt(2))

@@ -72,7 +72,7 @@ def test_a_survey_that_cannot_describe_a_well_is_refused_with_its_station(tmp_pa
 
 def test_a_scene_relates_its_string_and_its_well_or_says_why_not(tmp_path):
     """A survey file is found beside the scene file; a string longer than the well, a section wider than the hole
-    and file-plus-inline stations are refused with the key; the FE commands refuse a well they cannot model."""
+    and file-plus-inline stations are refused with the key, by torque-drag and by the FE model alike."""
     from fenics_drill.model.discretization import BeamDiscretization
     from fenics_drill.studies.torque_drag import torque_drag_study
 
@@ -94,8 +94,9 @@ def test_a_scene_relates_its_string_and_its_well_or_says_why_not(tmp_path):
         scene(sections=[dict(PIPE, inner_radius=0.07)])
     with pytest.raises(SceneError, match="unknown key string.sections\\[1\\].od"):
         scene(sections=[dict(PIPE, od=0.1)])
-    with pytest.raises(SceneError, match="the finite-element model runs one pipe of \\[beam\\]"):
-        BeamDiscretization.from_scene(s)
+    with pytest.raises(SceneError, match="longer than the well"):  # the FE string checks its well alike
+        BeamDiscretization.from_scene(s.with_changes(string={"sections": [dict(PIPE, length=600.0)]}))
+    assert BeamDiscretization.from_scene(s).properties.length == 400.0
 
 
 def test_a_hanging_string_carries_its_buoyed_weight_and_touches_nothing():

@@ -160,9 +160,10 @@ def _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torq
     ``rates``, read in place: a row view per vertex costs more than the law out of contact): its
     indentation, nodal loads and the loads of each law (the damper; the axial friction; the friction torque, or
     with ``coulomb`` the tangential part of the one friction force, lateral and torque); returns the springs'
-    energy.  ``arm``: the friction torque's arm, R_ext for the Coulomb force at the contact point, R_bh in (19)."""
+    energy.  ``gap``: each vertex's clearance; ``arm``: each vertex's friction torque's arm, its contact radius
+    for the Coulomb force at the contact point, R_bh in (19)."""
     r = np.hypot(v, w)
-    d = r - gap
+    d = r - gap[i]
     delta[i] = d
     if d <= 0.0:
         return 0.0
@@ -171,14 +172,14 @@ def _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torq
     damper = normal + k1 * d + k2 * d**3  # with the clip that keeps the wall from pulling
     laws[i, 1, 0], laws[i, 2, 0] = damper * n_v, damper * n_w
     if coulomb:  # t = (-n_w, n_v): the wall's tangent, the direction the contact point turns with theta_x
-        tangential_slip = -n_w * rates[i, 1] + n_v * rates[i, 2] + arm * rates[i, 3]
+        tangential_slip = -n_w * rates[i, 1] + n_v * rates[i, 2] + arm[i] * rates[i, 3]
         axial, tangential = _coulomb(normal, rates[i, 0], tangential_slip, mu_axial, v_s)
-        nodal[i, 0], nodal[i, 3] = axial, arm * tangential
+        nodal[i, 0], nodal[i, 3] = axial, arm[i] * tangential
         nodal[i, 1], nodal[i, 2] = normal * n_v - tangential * n_w, normal * n_w + tangential * n_v
         laws[i, 0, 1] = axial
-        laws[i, 1, 2], laws[i, 2, 2], laws[i, 3, 2] = -tangential * n_w, tangential * n_v, arm * tangential
+        laws[i, 1, 2], laws[i, 2, 2], laws[i, 3, 2] = -tangential * n_w, tangential * n_v, arm[i] * tangential
     else:
-        axial, torque = _friction(normal, rates[i, 0], rates[i, 3], mu_axial, mu_torque, arm, v_s)
+        axial, torque = _friction(normal, rates[i, 0], rates[i, 3], mu_axial, mu_torque, arm[i], v_s)
         nodal[i, 0], nodal[i, 1], nodal[i, 2], nodal[i, 3] = axial, normal * n_v, normal * n_w, torque
         laws[i, 0, 1] = axial
         laws[i, 3, 2] = torque
@@ -268,7 +269,7 @@ def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_ax
         i = active[k]
         v, w = lateral[i, 0], lateral[i, 1]
         r = np.hypot(v, w)
-        d = r - gap
+        d = r - gap[i]
         n_v, n_w = v / r, w / r
         dv, dw = rates[i, 1], rates[i, 2]
         d_rate = n_v * dv + n_w * dw
@@ -283,9 +284,9 @@ def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_ax
         dfn_w = c_u * (spring * n_w + damper_by_rate * (dw - d_rate * n_w) / r) + c_v * damper_by_rate * n_w
         if coulomb:
             _coulomb_block(blocks[k], normal, dfn_v, dfn_w, n_v, n_w, r, d_rate, dv, dw, rates[i, 0], rates[i, 3],
-                           mu_axial, arm, v_s, c_u, c_v)
+                           mu_axial, arm[i], v_s, c_u, c_v)
             continue
-        radius_bh = arm
+        radius_bh = arm[i]
         s_a = _regularised_sign(rates[i, 0], v_s)
         s_t = _regularised_sign(radius_bh * rates[i, 3], v_s)
         fa, ft = mu_axial * s_a, mu_torque * radius_bh * s_t  # F_a = fa F_n, T = ft F_n
@@ -473,7 +474,7 @@ class WallForces(ForceEvaluation):
     delta: np.ndarray = None  # their indentations
     nodal: np.ndarray = None  # their loads (F_a, F_v, F_w, T)
     tangent_data: tuple | None = None  # what :meth:`WallContact.tangent` needs, if asked for
-    tangential_arm: float = 0.0  # with the Coulomb force: its torque's arm R_ext (T = R_ext F_t); 0: no lateral part
+    tangential_arm: np.ndarray | None = None  # Coulomb force: each vertex's torque arm (T = R F_t); None: no lateral part
 
     @functools.cached_property
     def indentation(self) -> np.ndarray:
@@ -498,9 +499,9 @@ class WallForces(ForceEvaluation):
         """F_n (<= 0) at the vertices in contact: the lateral load less its friction part along the wall, which is
         normal to it (|F_lateral|^2 = F_n^2 + F_t^2, F_t = T / R_ext)."""
         lateral = np.hypot(self._active[:, 1], self._active[:, 2])
-        if not self.tangential_arm:
+        if self.tangential_arm is None:
             return -lateral
-        tangential = self._active[:, 3] / self.tangential_arm
+        tangential = self._active[:, 3] / self.tangential_arm[self.vertices[self.delta > 0]]
         return -np.sqrt(np.maximum(lateral**2 - tangential**2, 0.0))
 
     @property
@@ -545,11 +546,11 @@ class WallContact:
         of the paper's model; ``damper_law``: the damper of (17); ``culling``: evaluate the law only at the
         vertices that can reach the wall (exact)."""
         self.x = disc.vertex_x
-        self.gap = borehole_radius - disc.properties.outer_radius
-        self.borehole_radius = borehole_radius
+        contact_radius, hole_radius = disc.vertex_radii(borehole_radius)
+        self.gap = hole_radius - contact_radius  # per vertex
         self.coulomb = contact.friction_model == "coulomb"
         # the friction torque's arm: the pipe's surface, where the Coulomb force acts; the borehole's radius in (19)
-        self.arm = disc.properties.outer_radius if self.coulomb else borehole_radius
+        self.arm = contact_radius if self.coulomb else hole_radius
         self.law_names = ("wall_damper", "wall_friction_axial", "wall_friction_tangential") if self.coulomb else \
             ("wall_damper", "wall_axial_friction", "wall_friction_torque")
         self.k1, self.k2 = contact.stiffness_linear, contact.stiffness_cubic
@@ -603,10 +604,11 @@ class WallContact:
     def record(self, forces: "WallForces") -> dict[str, float]:
         return {"vertices_in_contact": int(np.count_nonzero(forces.delta > 0))}
 
-    def _law(self) -> tuple:
-        """The law's constants, in the order the compiled kernels take them."""
-        return (self.gap, self.k1, self.k2, self.c, self.damper_law == "printed", self.mu_axial, self.mu_torque,
-                self.arm, self.v_s, self.coulomb)
+    def _law(self, vertices: np.ndarray | None = None) -> tuple:
+        """The law's constants at ``vertices`` (default: all), in the order the compiled kernels take them."""
+        at = slice(None) if vertices is None else vertices
+        return (np.ascontiguousarray(self.gap[at]), self.k1, self.k2, self.c, self.damper_law == "printed",
+                self.mu_axial, self.mu_torque, np.ascontiguousarray(self.arm[at]), self.v_s, self.coulomb)
 
     #: Vertices within this share of the gap from the wall are evaluated; the others are left out until
     #: q has moved enough, by the bound of :meth:`_near_vertices`, to possibly bring one of them to it.
@@ -626,7 +628,7 @@ class WallContact:
         watched = far if far.any() else np.ones_like(far)  # without far vertices: every vertex, until q moves
         sizes = self._column_sizes[np.flatnonzero(watched)].max(axis=0)
         column_bound = sizes.toarray().ravel() if sp.issparse(sizes) else np.asarray(sizes).ravel()
-        reach = float(np.min(slack[far])) if far.any() else self.NEAR * self.gap
+        reach = float(np.min(slack[far])) if far.any() else self.NEAR * float(np.min(self.gap))
         vertices = np.flatnonzero(~far)
         rows = (len(FIELDS) * vertices[:, None] + np.arange(len(FIELDS))).ravel()
         lateral = (2 * vertices[:, None] + np.arange(2)).ravel()
@@ -643,11 +645,11 @@ class WallContact:
         if sp.issparse(vertex_set.flat):  # the full space: the rows select dofs
             lateral = (vertex_set.lateral_rows @ q).reshape(-1, 2)
             rates = (vertex_set.flat @ qd).reshape(-1, len(FIELDS))
-            delta, nodal, laws, potential = _vertex_loads(lateral, rates, *self._law())
+            delta, nodal, laws, potential = _vertex_loads(lateral, rates, *self._law(vertex_set.vertices))
             generalised = np.asarray(vertex_set.flat.T @ nodal.ravel())
         else:
             delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(
-                vertex_set.packed.kernel_data(), q.size, q, qd, *self._law())
+                vertex_set.packed.kernel_data(), q.size, q, qd, *self._law(vertex_set.vertices))
         return self.forces_of(vertex_set, (delta, nodal, laws, potential, generalised, lateral, rates), with_tangent)
 
     def forces_of(self, vertex_set: VertexSet, passed: tuple, with_tangent: bool) -> WallForces:
@@ -656,9 +658,9 @@ class WallContact:
         delta, nodal, laws, potential, generalised, lateral, rates = passed
         by_law = ProjectedLaws(vertex_set, delta, laws, self.law_names)
         out = WallForces(generalised, potential, by_law, len(self.x), vertex_set.vertices, delta, nodal,
-                         tangential_arm=self.arm if self.coulomb else 0.0)
+                         tangential_arm=self.arm if self.coulomb else None)
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
-            out.tangent_data = (vertex_set.flat, lateral, rates)
+            out.tangent_data = (vertex_set.flat, lateral, rates, vertex_set.vertices)
         return out
 
     def evaluated_vertices(self) -> VertexSet:
@@ -671,7 +673,8 @@ class WallContact:
         sizes, reference q and reach; none for every vertex) for
         :func:`~fenics_drill.solvers.compiled_residual.residual_at`."""
         size = vertex_set.flat.shape[1]
-        law = tuple(value if isinstance(value, bool) else float(value) for value in self._law())
+        law = tuple(value if isinstance(value, (bool, np.ndarray)) else float(value)
+                    for value in self._law(vertex_set.vertices))
         rows = vertex_set.packed.kernel_data()
         if vertex_set.q_ref is None:
             return rows, law, np.zeros(size), np.zeros(size), np.inf
@@ -685,11 +688,11 @@ class WallContact:
         Newton, and the residual, in double precision, decides when it has converged."""
         if forces.tangent_data is None:
             return None
-        flat, lateral, rates = forces.tangent_data
+        flat, lateral, rates, vertices = forces.tangent_data
         active = np.flatnonzero(forces.delta > 0)
         if active.size == 0:
             return None
-        blocks = _contact_blocks(active, lateral, rates, *self._law(), c_u, c_v)
+        blocks = _contact_blocks(active, lateral, rates, *self._law(vertices), c_u, c_v)
         if sp.issparse(flat):  # the full space: each row of [Phi] selects one free dof (or none, at a support)
             columns, values = _selection(flat)
             at = len(FIELDS) * active[:, None] + np.arange(len(FIELDS))

@@ -72,16 +72,18 @@ def bit_loads(disc: BeamDiscretization) -> dict[str, np.ndarray]:
 
 
 def wall_rest_load(disc: BeamDiscretization, gravity: np.ndarray, gravity_response: np.ndarray,
-                   gap: float) -> np.ndarray | None:
+                   gap) -> np.ndarray | None:
     """The wall's reaction on a string at rest, estimated from the linear sag: the vertices the sag
-    takes beyond the gap rest on the wall, which carries their weight.  None if none do."""
+    takes beyond the gap (one per vertex, or one for all) rest on the wall, which carries their lateral weight.
+    None if none do."""
     w_dofs, v_dofs = disc.vertex_dofs(W), disc.vertex_dofs(V)
     radius = np.hypot(gravity_response[v_dofs], gravity_response[w_dofs])
     resting = radius > gap
     if not resting.any():
         return None
     load = np.zeros(disc.ndofs)
-    load[w_dofs[resting]] = -gravity[w_dofs[resting]]
+    for dofs in (v_dofs[resting], w_dofs[resting]):
+        load[dofs] = -gravity[dofs]
     return load
 
 
@@ -115,7 +117,7 @@ def climbing_friction(scene, disc: BeamDiscretization, operators: LinearOperator
             and contact.friction > 0 and scene.drive.rotation_speed != 0 and np.any(operators.gravity)):
         return None
     statics = StaticSolver(disc, operators)
-    gap = scene.borehole.radius - scene.beam.outer_radius
+    gap = disc.vertex_gap(scene.borehole.radius)
     if wall_rest_load(disc, operators.gravity, statics.responses(operators.gravity)[:, 0], gap) is None:
         return None
     return ("the spinning string rests on the wall with Coulomb friction at the contact point: it climbs and swings "
@@ -130,7 +132,7 @@ def scene_loads(scene, disc: BeamDiscretization, operators: LinearOperators, sta
     if scene.model.bit_rock:
         loads.update(bit_loads(disc))
     if scene.model.contact and "gravity" in loads:
-        gap = scene.borehole.radius - scene.beam.outer_radius
+        gap = disc.vertex_gap(scene.borehole.radius)
         wall = wall_rest_load(disc, operators.gravity, statics.responses(operators.gravity)[:, 0], gap)
         if wall is not None:
             loads["wall_at_rest"] = wall
@@ -177,7 +179,7 @@ def missed_share(phi: np.ndarray, stiffness, constraints: np.ndarray, vector: np
 def axial_companions(disc: BeamDiscretization, statics: StaticSolver, vectors: np.ndarray,
                      kinematics: str) -> np.ndarray:
     """theta_i = -K^-1 D^2 f_el(0)[phi_i, phi_i] for each column phi_i (static modal derivatives)."""
-    p = disc.properties
+    p = disc.form_properties
     dx = ufl.Measure("dx", domain=disc.mesh, metadata={"quadrature_degree": 2 * disc.element_degree})
     zero, direction = fem.Function(disc.V), fem.Function(disc.V)
     force = energies.elastic_force(p, ufl.TestFunction(disc.V), zero, dx, True, kinematics)
