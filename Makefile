@@ -72,12 +72,14 @@ campbell: setup
 		--overwrite --out $(OUT)/campbell-wob
 
 ## The two demo wells (docs/wells.md): soft-string torque and drag, buckling, figures; the manual's copies of the
-## figures and the convergence-and-cost table (benchmarks/results/torque_drag_wells.md).  A few seconds each.
+## figures, the convergence-and-cost table (benchmarks/results/torque_drag_wells.md) and the FE string at rest against
+## the soft string (benchmarks/results/fe_wells.md, a few minutes).
 wells: setup
 	$(PY) -m fenics_drill.cli torque-drag demos/scenes/well_vbh.toml --overwrite --out $(OUT)/well-vbh
 	$(PY) -m fenics_drill.cli torque-drag demos/scenes/well_3d.toml --overwrite --out $(OUT)/well-3d
 	for w in vbh 3d; do for f in well_loads well_path well_3d; do cp $(OUT)/well-$$w/$$f.png docs/figures/$${f}_$$w.png; done; done
 	$(PY) benchmarks/torque_drag_wells.py
+	$(PY) benchmarks/fe_wells.py
 
 ## The paper's Monte Carlo study (Section 6.11) at SAMPLES realisations on RANKS processes (with the default Coulomb
 ## friction each realisation of 10 s runs the full order, about 160 s on one core here).

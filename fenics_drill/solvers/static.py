@@ -60,9 +60,9 @@ def solve_static(model: DrillstringModel, tolerance: float = 1e-8, max_iteration
     """Equilibrium of the string at rest (velocities zero, so no friction and no bit-rock force).
 
     From the straight string with wall contact, the wall springs are stiffened stage by stage
-    (:data:`FIRST_STAGE`, :data:`STAGE_STEP`) on copies of the model; the model itself is left as it was.  From an
-    ``initial`` guess near the equilibrium (the full-order state projected on a reduced basis), one
-    Newton solve with the real wall."""
+    (:data:`FIRST_STAGE`, :data:`STAGE_STEP`) on copies of the model; the model itself is left as it was.  On a
+    well, first one Newton solve with the real wall from :func:`resting_guess`.  From an ``initial`` guess near the
+    equilibrium (the full-order state projected on a reduced basis), one Newton solve with the real wall."""
     model = model.at_rest()  # both drive dofs held, whatever drives the run
     wall = model.force("wall")
     q, mu = (np.zeros(model.size) if initial is None else initial), np.zeros(2)
@@ -70,7 +70,10 @@ def solve_static(model: DrillstringModel, tolerance: float = 1e-8, max_iteration
         return _newton(model, q, mu, tolerance, max_iterations)
     resting = resting_guess(model)
     if resting is not None:  # a well: from the string the soft-string model lays on the wall, the real wall at once
-        return _newton(model, resting, mu, tolerance, max_iterations)
+        try:
+            return _newton(model, resting, mu, tolerance, max_iterations)
+        except StaticFailure:  # (a string the soft string leaves near the axis): the stages from the straight one
+            pass
     return _staged(model, wall, q, mu, tolerance, max_iterations)
 
 
