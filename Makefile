@@ -78,6 +78,8 @@ wells: setup
 	$(PY) -m fenics_drill.cli torque-drag demos/scenes/well_vbh.toml --overwrite --out $(OUT)/well-vbh
 	$(PY) -m fenics_drill.cli torque-drag demos/scenes/well_3d.toml --overwrite --out $(OUT)/well-3d
 	for w in vbh 3d; do for f in well_loads well_path well_3d; do cp $(OUT)/well-$$w/$$f.png docs/figures/$${f}_$$w.png; done; done
+	$(PY) -m fenics_drill.cli static demos/scenes/well_vbh.toml --set beam.elements=1000 --overwrite --out $(OUT)/well-vbh-static
+	cp $(OUT)/well-vbh-static/static_loads.png docs/figures/static_loads_vbh.png
 	$(PY) benchmarks/torque_drag_wells.py
 	$(PY) benchmarks/fe_wells.py
 

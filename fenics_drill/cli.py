@@ -63,14 +63,20 @@ def cmd_modal(args) -> int:
 
 
 def cmd_static(args) -> int:
-    """Static equilibrium under gravity with wall contact (Section 6.4): DIR/static.json, DIR/static.xdmf."""
+    """Static equilibrium under gravity with wall contact (Section 6.4): DIR/static.json, DIR/static.xdmf; on a well
+    DIR/static_profiles.h5 and static_loads.png."""
     from fenics_drill.studies.run import run_static
 
     scene = load_scene(args.scene, args.overrides)
     report = run_static(scene, args.out, overwrite=args.overwrite)
+    if (Path(args.out) / "static_profiles.h5").exists():  # a well: its loads along it
+        from fenics_drill.plots.directory import plot_directory
+
+        plot_directory(Path(args.out))
     print(
         f"max sag {report['max_sag'] * 1e3:.3f} mm at x = {report['max_sag_position']:.1f} m, "
-        f"{len(report['contact_vertices'])} vertices on the wall -> {Path(args.out) / 'static.json'}"
+        f"{len(report['contact_vertices'])} vertices on the wall, hook load {report['hook_load'] / 1e3:.2f} kN "
+        f"-> {Path(args.out) / 'static.json'}"
     )
     for reason in report.get("suspect_reasons", []):
         print(f"suspect: {reason}")

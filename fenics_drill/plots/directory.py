@@ -49,14 +49,15 @@ def drawn_from(directory: Path) -> dict:
         summary = {}
     status = summary.get("status", "unknown")
     for kind, name in (("torque-drag", "torque_drag.json"), ("campbell", "campbell.json"), ("optimize", "optimize.json"), ("mc", "statistics.h5"),
-                       ("run", "timeseries.h5")):
+                       ("run", "timeseries.h5"), ("static", "static_profiles.h5")):
         if (directory / name).exists():
             break
     else:
         said = f" (its command is {status}: {summary.get('message')})" if summary.get("message") else ""
         raise NothingToPlot(f"{directory} holds no timeseries.h5 ('fenics-drill run'), statistics.h5 "
                             "('fenics-drill mc'), optimize.json ('fenics-drill optimize'), campbell.json "
-                            f"('fenics-drill campbell') or torque_drag.json ('fenics-drill torque-drag'){said}")
+                            "('fenics-drill campbell'), torque_drag.json ('fenics-drill torque-drag') or "
+                            f"static_profiles.h5 ('fenics-drill static' on a well){said}")
     state = {"kind": kind, "status": status}
     if kind == "run":
         data, attrs = read_series(directory / "timeseries.h5")  # UnreadableFile names a broken file
@@ -83,6 +84,10 @@ def _draw(directory: Path, kind: str, gif: bool) -> list[Path]:
         from fenics_drill.plots.well import well_figures
 
         return well_figures(directory)
+    if kind == "static":
+        from fenics_drill.plots.well import static_loads_figure
+
+        return [static_loads_figure(directory)]
     if kind == "campbell":
         from fenics_drill.plots.campbell import campbell_figure
 

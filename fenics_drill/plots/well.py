@@ -1,6 +1,6 @@
 """Figures of a torque-and-drag study: the loads along the string for each operation (``well_loads.png``), the
 well's path with the string's buckled lengths (``well_path.png``), and the string in 3D coloured by its wall contact
-force (``well_3d.png``)."""
+force (``well_3d.png``); and of the FE static state on a well (``static_loads.png``)."""
 
 from __future__ import annotations
 
@@ -38,21 +38,47 @@ def loads_figure(report: dict, profiles, path: Path) -> Path:
         axes[1].plot(profiles[f"torque_{name}"].values / 1e3, md, color=line.get_color())
         axes[2].step(profiles[f"wall_force_per_length_{name}"].values, md_e, where="mid", color=line.get_color(),
                      lw=1)
-    axes[0].plot(-profiles["sinusoidal_buckling_load"].values / 1e3, md_e, "k--", lw=1, label="sinusoidal buckling")
-    axes[0].plot(-profiles["helical_buckling_load"].values / 1e3, md_e, "k:", lw=1, label="helical buckling")
+    _tension_axes(axes, profiles)
     lowest = min(float(profiles[f"tension_{n}"].min()) for n in report["operations"])
     axes[0].set_xlim(left=min(1.5 * lowest, -1.0) / 1e3)
-    axes[0].set_xlabel("effective tension [kN]")
     axes[1].set_xlabel("torque [kN m]")
     axes[2].set_xlabel("wall contact force [N/m]")
+    fig.suptitle(f"Soft-string torque and drag: {report['well']['measured_depth_m']:.0f} m well, "
+                 f"{report['string']['length_m']:.0f} m string")
+    return save_figure(fig, path)
+
+
+def _tension_axes(axes, profiles) -> None:
+    """The buckling loads as compression limits on the tension axes (the first), measured depth down the page."""
+    md_e = profiles["md_element"].values
+    axes[0].plot(-profiles["sinusoidal_buckling_load"].values / 1e3, md_e, "k--", lw=1, label="sinusoidal buckling")
+    axes[0].plot(-profiles["helical_buckling_load"].values / 1e3, md_e, "k:", lw=1, label="helical buckling")
+    axes[0].set_xlabel("effective tension [kN]")
     axes[0].set_ylabel("measured depth [m]")
     axes[0].invert_yaxis()
     for ax in axes:
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8, loc="lower left")
-    fig.suptitle(f"Soft-string torque and drag: {report['well']['measured_depth_m']:.0f} m well, "
-                 f"{report['string']['length_m']:.0f} m string")
-    return save_figure(fig, path)
+
+
+def static_loads_figure(directory: Path) -> Path:
+    """The FE static state along its well (``static_profiles.h5``): its effective tension against the soft string's
+    off bottom and the buckling loads as compression limits, its torque, and the wall's force per length."""
+    import xarray
+
+    profiles = xarray.load_dataset(directory / "static_profiles.h5", engine="h5netcdf")
+    md, md_e = profiles["md"].values, profiles["md_element"].values
+    fig, axes = plt.subplots(1, 2, figsize=(10, 7), sharey=True)
+    axes[0].plot(profiles["axial_force"].values / 1e3, md_e, label="FE static state")
+    axes[0].plot(profiles["soft_string_tension"].values / 1e3, md, "--", label="soft string, off bottom")
+    axes[1].plot(profiles["wall_force_per_length"].values, md, lw=1)
+    _tension_axes(axes, profiles)
+    lowest = float(min(profiles["axial_force"].min(), profiles["soft_string_tension"].min()))
+    highest = float(max(profiles["axial_force"].max(), profiles["soft_string_tension"].max()))
+    axes[0].set_xlim(min(1.5 * lowest, -0.2 * highest) / 1e3, 1.1 * max(highest, 1.0) / 1e3)
+    axes[1].set_xlabel("wall contact force [N/m] (at the vertices)")
+    fig.suptitle("The FE string at rest in its well")
+    return save_figure(fig, directory / "static_loads.png")
 
 
 def path_figure(report: dict, profiles, path: Path) -> Path:

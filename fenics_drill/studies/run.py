@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from fenics_drill.io.fields import FieldWriter
-from fenics_drill.io.files import no_room_message, write_final_json, write_json
+from fenics_drill.io.files import no_room_message, write_atomic, write_final_json, write_json
 from fenics_drill.io.output_directory import claim_output, remove_figures
 from fenics_drill.io.timeseries import TimeSeriesWriter, read_series
 from fenics_drill.model.discretization import THETA_X, THETA_Y, THETA_Z, U, V, W
@@ -37,6 +37,7 @@ from fenics_drill.solvers.step_control import StepTooSmall, nominal_step, steps_
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
 from fenics_drill.studies.lifecycle import StopOnSignal, command_output, uninterrupted
 from fenics_drill.studies.prepare import prepare
+from fenics_drill.studies.torque_drag import fe_static_profiles
 
 
 #: A nominal step that resolves the band's highest frequency f_max with fewer steps per period than the
@@ -78,7 +79,8 @@ SMALL_ADVANCE = 20.0
 
 
 def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
-    """Static equilibrium of the scene (Section 6.4): DIR/static.json, DIR/static.xdmf, DIR/summary.json."""
+    """Static equilibrium of the scene (Section 6.4): DIR/static.json, DIR/static.xdmf, DIR/summary.json; on a well
+    DIR/static_profiles.h5 (:func:`~fenics_drill.studies.torque_drag.fe_static_profiles`)."""
     out = Path(out)
     with command_output(out, "static", scene, overwrite) as summary:
         prepared = prepare(scene, dynamics=False)
@@ -93,6 +95,9 @@ def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
         writer = FieldWriter(model.disc, out / "static.xdmf")
         writer.write(model.space.expand(equilibrium.q), 0.0)
         writer.close()
+        if model.disc.trajectory is not None or model.disc.sections is not None:  # a well: its loads along it
+            profiles = fe_static_profiles(scene, model, equilibrium.q)
+            write_atomic(out / "static_profiles.h5", lambda tmp: profiles.to_netcdf(tmp, engine="h5netcdf"))
         write_json(out / "static.json", report)
         summary["message"] = "static.json"
     return report

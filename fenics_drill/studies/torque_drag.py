@@ -4,7 +4,8 @@
 
 Files: ``torque_drag.json`` (the well, the string, and per operation the surface loads and where the string buckles),
 ``torque_drag.h5`` (the profiles, an xarray/netCDF-4 dataset over the nodes' measured depth) and ``well.vtu`` (the
-string's axis with its profiles, for ParaView).
+string's axis with its profiles, for ParaView).  On a well, ``fenics-drill static`` writes the FE static state's
+profiles beside the soft string's (:func:`fe_static_profiles`, ``static_profiles.h5``).
 """
 
 from __future__ import annotations
@@ -16,10 +17,12 @@ import meshio
 import numpy as np
 
 from fenics_drill.io.files import write_atomic, write_json
+from fenics_drill.model.discretization import THETA_X, THETA_Y, THETA_Z, U, V, W
 from fenics_drill.model.soft_string import operations, soft_string, stretch, string_mesh
 from fenics_drill.model.string_sections import string_sections
 from fenics_drill.model.well import dogleg_severity_deg_per_30m, well_of
 from fenics_drill.observables.buckling import helical_load, sinusoidal_load
+from fenics_drill.observables.torque_drag import string_profiles
 from fenics_drill.scene import SceneError
 from fenics_drill.studies.lifecycle import command_output
 
@@ -121,6 +124,39 @@ def _write_vtu(path: Path, profiles) -> None:
     data = {name: values.values for name, values in profiles.data_vars.items() if values.dims == ("md",)}
     write_atomic(path, lambda tmp: meshio.write_points_cells(str(tmp), points, cells, point_data=data,
                                                              file_format="vtu"))
+
+
+def fe_static_profiles(scene, model, q):
+    """The FE static state ``q`` of a string in its well along measured depth, as an ``xarray.Dataset``: its axial
+    force (the effective tension: the FE weighs the pipe in the mud) and torque on each element (``md_element``)
+    with the sinusoidal and helical buckling loads there, its wall force per length at the vertices (``md``), and the
+    soft string's effective tension off bottom (no axial friction) for comparison."""
+    import xarray
+
+    disc = model.disc
+    dofs = model.space.expand(q)
+    fields = [dofs[disc.vertex_dofs(f)] for f in (U, V, W, THETA_X, THETA_Y, THETA_Z)]
+    contact = scene.contact
+    on = scene.model.contact
+    loads = string_profiles(disc.vertex_x, *fields[:4], disc.element_properties, model.vertex_gap,
+                            contact.stiffness_linear if on else 0.0, contact.stiffness_cubic if on else 0.0,
+                            *fields[4:], disc.element_curvature)
+    x = disc.vertex_x
+    middle = 0.5 * (x[1:] + x[:-1])
+    p = disc.element_properties
+    stiffness, weight = p.young_modulus * p.section.I4, p.density * p.section.area * p.gravity
+    clearance = np.minimum(model.vertex_gap[1:], model.vertex_gap[:-1])
+    trajectory = disc.trajectory if disc.trajectory is not None else well_of(scene, disc.properties.length).trajectory
+    inclination, curvature = trajectory.inclination(middle), trajectory.curvature(middle)
+    soft = torque_drag_study(scene.with_changes(torque_drag={"operations": ["rotating_off_bottom"]}))["profiles"]
+    return xarray.Dataset(
+        {"axial_force": ("md_element", loads["axial_force"]), "torque": ("md_element", loads["torque"]),
+         "wall_force_per_length": ("md", loads["wall_normal_force_per_length"]),
+         "sinusoidal_buckling_load": ("md_element", sinusoidal_load(stiffness, weight, inclination, clearance,
+                                                                    curvature)),
+         "helical_buckling_load": ("md_element", helical_load(stiffness, weight, inclination, clearance, curvature)),
+         "soft_string_tension": ("md", np.interp(x, soft["md"].values, soft["tension_rotating_off_bottom"].values))},
+        coords={"md": x, "md_element": middle})
 
 
 def write_torque_drag(scene, out: str | Path, overwrite: bool = False) -> dict:

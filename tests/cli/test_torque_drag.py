@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 
 import meshio
+import numpy as np
 import pytest
 import xarray as xr
 
@@ -65,3 +66,24 @@ def test_a_bad_survey_is_a_one_line_scene_error(tmp_path, capsys):
     assert main(["torque-drag", str(bad), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert "station 3: md = 400 m does not exceed the station before" in err and "Traceback" not in err
+
+
+def test_static_on_a_well_writes_its_loads_along_the_well_beside_the_soft_strings(tmp_path, capsys):
+    """``fenics-drill static`` on the 3 km VBH demo well: the hook load, the profiles (the FE effective tension, the
+    soft string's, the buckling loads) and their figure.  The hook load is the soft string's off bottom (1e-3,
+    measured 2.0e-4), and so is the FE tension, in the vertical section and the lateral within 1e-3 of the hook load
+    (measured 2.0e-4 and 9e-5: the two models carry the weight alike), in the build within 1 % (6.1e-3: the stiff
+    pipe crosses the hole there, on 12 m elements)."""
+    assert main(["static", str(VBH), "--out", str(tmp_path)]) == 0
+    assert "hook load" in capsys.readouterr().out
+    report = json.loads((tmp_path / "static.json").read_text())
+    profiles = xr.load_dataset(tmp_path / "static_profiles.h5", engine="h5netcdf")
+    force, middle = profiles["axial_force"].values, profiles["md_element"].values
+    soft = profiles["soft_string_tension"].values
+    assert report["hook_load"] == pytest.approx(soft[0], rel=1e-3)
+    error = abs(force - np.interp(middle, profiles["md"].values, soft)) / report["hook_load"]
+    build = (middle > 1000.0) & (middle < 1675.0)
+    assert error[(middle < 1000.0) | (middle > 1675.0) & (middle < 2900.0)].max() < 1e-3
+    assert error[build].max() < 1e-2
+    assert profiles["helical_buckling_load"].values.min() > profiles["sinusoidal_buckling_load"].values.min() > 0
+    assert (tmp_path / "static_loads.png").stat().st_size > 10_000
