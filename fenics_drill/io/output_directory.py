@@ -40,8 +40,8 @@ FIGURE_RECORD = "figures.json"
 OWNED = {
     "run": ("summary.json", "timeseries.h5", "fields.xdmf", "fields.h5", "fig*.png", "torque_drag.png",
             "spectra.json", "animation.gif", FIGURE_RECORD),
-    "static": ("summary.json", "static.json", "static.xdmf", "static.h5", "static_profiles.h5", "static_loads.png",
-               FIGURE_RECORD),
+    "static": ("summary.json", "static.json", "static.xdmf", "static.h5", "static_profiles.h5", "static_path.vtu",
+               "static_loads.png", FIGURE_RECORD),
     "modal": ("summary.json", "modes.json"),
     "campbell": ("summary.json", "campbell.json", "campbell.png", FIGURE_RECORD),
     "mc": ("summary.json", "scene.json", "nominal.h5", "nominal.h5.corrupt", "realisations", "statistics.h5", "fig*.png",

@@ -37,7 +37,7 @@ from fenics_drill.solvers.step_control import StepTooSmall, nominal_step, steps_
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
 from fenics_drill.studies.lifecycle import StopOnSignal, command_output, uninterrupted
 from fenics_drill.studies.prepare import prepare
-from fenics_drill.studies.torque_drag import fe_static_profiles
+from fenics_drill.studies.torque_drag import fe_static_profiles, write_path_vtu
 
 
 #: A nominal step that resolves the band's highest frequency f_max with fewer steps per period than the
@@ -80,7 +80,8 @@ SMALL_ADVANCE = 20.0
 
 def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
     """Static equilibrium of the scene (Section 6.4): DIR/static.json, DIR/static.xdmf, DIR/summary.json; on a well
-    DIR/static_profiles.h5 (:func:`~fenics_drill.studies.torque_drag.fe_static_profiles`)."""
+    DIR/static_profiles.h5 (:func:`~fenics_drill.studies.torque_drag.fe_static_profiles`) and static_path.vtu (the
+    string where it lies in the hole, for ParaView)."""
     out = Path(out)
     with command_output(out, "static", scene, overwrite) as summary:
         prepared = prepare(scene, dynamics=False)
@@ -98,6 +99,7 @@ def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
         if model.disc.trajectory is not None or model.disc.sections is not None:  # a well: its loads along it
             profiles = fe_static_profiles(scene, model, equilibrium.q)
             write_atomic(out / "static_profiles.h5", lambda tmp: profiles.to_netcdf(tmp, engine="h5netcdf"))
+            write_path_vtu(out / "static_path.vtu", profiles)
         write_json(out / "static.json", report)
         summary["message"] = "static.json"
     return report

@@ -117,8 +117,8 @@ def _dataset(profiles: dict):
     return xarray.Dataset(variables, coords={"md": profiles["md"], "md_element": profiles["md_element"]})
 
 
-def _write_vtu(path: Path, profiles) -> None:
-    """The string's axis as a polyline (x north, y east, z up) with its node profiles, for ParaView."""
+def write_path_vtu(path: Path, profiles) -> None:
+    """The string as a polyline through its nodes (x north, y east, z up) with its node profiles, for ParaView."""
     points = np.column_stack([profiles["north"].values, profiles["east"].values, -profiles["tvd"].values])
     cells = [("line", np.column_stack([np.arange(points.shape[0] - 1), np.arange(1, points.shape[0])]))]
     data = {name: values.values for name, values in profiles.data_vars.items() if values.dims == ("md",)}
@@ -130,7 +130,8 @@ def fe_static_profiles(scene, model, q):
     """The FE static state ``q`` of a string in its well along measured depth, as an ``xarray.Dataset``: its axial
     force (the effective tension: the FE weighs the pipe in the mud) and torque on each element (``md_element``)
     with the sinusoidal and helical buckling loads there, its wall force per length at the vertices (``md``), and the
-    soft string's effective tension off bottom (no axial friction) for comparison."""
+    soft string's effective tension off bottom (no axial friction) for comparison; where each vertex lies (north,
+    east, true vertical depth: the axis plus the lateral displacement) and how far it is off the axis."""
     import xarray
 
     disc = model.disc
@@ -149,13 +150,18 @@ def fe_static_profiles(scene, model, q):
     trajectory = disc.trajectory if disc.trajectory is not None else well_of(scene, disc.properties.length).trajectory
     inclination, curvature = trajectory.inclination(middle), trajectory.curvature(middle)
     soft = torque_drag_study(scene.with_changes(torque_drag={"operations": ["rotating_off_bottom"]}))["profiles"]
+    frames = trajectory.bishop_frames(x)
+    lateral = fields[1][:, None] * frames.d2 + fields[2][:, None] * frames.d3
+    position = trajectory.positions(x) + lateral  # where the string's axis lies in the hole
     return xarray.Dataset(
         {"axial_force": ("md_element", loads["axial_force"]), "torque": ("md_element", loads["torque"]),
          "wall_force_per_length": ("md", loads["wall_normal_force_per_length"]),
          "sinusoidal_buckling_load": ("md_element", sinusoidal_load(stiffness, weight, inclination, clearance,
                                                                     curvature)),
          "helical_buckling_load": ("md_element", helical_load(stiffness, weight, inclination, clearance, curvature)),
-         "soft_string_tension": ("md", np.interp(x, soft["md"].values, soft["tension_rotating_off_bottom"].values))},
+         "soft_string_tension": ("md", np.interp(x, soft["md"].values, soft["tension_rotating_off_bottom"].values)),
+         "north": ("md", position[:, 0]), "east": ("md", position[:, 1]), "tvd": ("md", -position[:, 2]),
+         "lateral_displacement": ("md", np.hypot(fields[1], fields[2]))},
         coords={"md": x, "md_element": middle})
 
 
@@ -166,7 +172,7 @@ def write_torque_drag(scene, out: str | Path, overwrite: bool = False) -> dict:
         study = torque_drag_study(scene)
         write_json(out / "torque_drag.json", study["report"])
         write_atomic(out / "torque_drag.h5", lambda tmp: study["profiles"].to_netcdf(tmp, engine="h5netcdf"))
-        _write_vtu(out / "well.vtu", study["profiles"])
+        write_path_vtu(out / "well.vtu", study["profiles"])
         summary["message"] = "torque_drag.json"
         summary["hook_load_N"] = {k: v["hook_load_N"] for k, v in study["report"]["operations"].items()}
         summary["surface_torque_Nm"] = {k: v["surface_torque_Nm"] for k, v in study["report"]["operations"].items()}

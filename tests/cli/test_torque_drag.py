@@ -87,3 +87,11 @@ def test_static_on_a_well_writes_its_loads_along_the_well_beside_the_soft_string
     assert error[build].max() < 1e-2
     assert profiles["helical_buckling_load"].values.min() > profiles["sinusoidal_buckling_load"].values.min() > 0
     assert (tmp_path / "static_loads.png").stat().st_size > 10_000
+    # the string where it lies, for ParaView: on the well's path, its bit (held on the axis) at the well's depth
+    from fenics_drill.model.well import well_of
+
+    path = meshio.read(tmp_path / "static_path.vtu")
+    assert path.points.shape == (profiles.sizes["md"], 3)
+    bottom = well_of(load_scene(VBH), 3000.0).trajectory.positions([3000.0])[0]
+    assert path.points[-1] == pytest.approx(bottom, abs=1e-9)
+    assert path.point_data["lateral_displacement"].max() < 0.03  # within the largest clearance
