@@ -31,7 +31,10 @@ FIGURES = (("flexural", "fig10_flexural_modes.png"), ("torsional", "fig11_torsio
 
 
 def report_for(length: float, elements: int) -> dict:
-    scene = load_scene(SCENE, [f"beam.length={length}", f"beam.elements={elements}"])
+    """The modal report of the paper's string at this length and mesh, with the paper's wall friction: the modes do
+    not depend on it, but Table 4 is the reduced basis the paper keeps, which the 'auto' rule chooses under that law
+    (under the default Coulomb force the spinning string climbs the wall and the rule takes the full order)."""
+    scene = load_scene(SCENE, [f"beam.length={length}", f"beam.elements={elements}", "contact.friction_model='paper'"])
     return modal_report(scene)
 
 

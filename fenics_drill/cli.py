@@ -115,6 +115,10 @@ def cmd_run(args) -> int:
             f"mean bit velocity {summary['mean_bit_velocity'] * 3600:.2f} m/h, rop {summary['rop'] * 3600:.2f} m/h, "
             f"impacts {summary['impacts_total']}, energy balance error {summary['energy']['balance_error']:.2e}"
         )
+    loads = summary.get("torque_and_drag")
+    if loads:
+        print(f"hook load {loads['hook_load']['mean_second_half'] / 1e3:.2f} kN, surface torque "
+              f"{loads['surface_torque']['mean_second_half'] / 1e3:.3f} kN m (means over the run's second half)")
     for reason in summary.get("suspect_reasons", []):
         print(f"SUSPECT: {reason}")
     for advice in summary.get("advice", []):
