@@ -50,7 +50,7 @@ def test_the_default_well_is_the_paper_hole_and_running_in_it_locks_up(tmp_path,
     assert main(["torque-drag", *survey, "--out", str(tmp_path / "survey")]) == 0
     a = json.loads((default / "torque_drag.json").read_text())["operations"]
     b = json.loads((tmp_path / "survey" / "torque_drag.json").read_text())["operations"]
-    for name in a:
+    for name in a:  # one hole described two ways: equal to round-off (abs: the torques that vanish)
         assert b[name]["hook_load_N"] == pytest.approx(a[name]["hook_load_N"], rel=1e-12, abs=1e-9)
         assert b[name]["surface_torque_Nm"] == pytest.approx(a[name]["surface_torque_Nm"], rel=1e-12, abs=1e-12)
     scene = load_scene(None)
@@ -93,5 +93,5 @@ def test_static_on_a_well_writes_its_loads_along_the_well_beside_the_soft_string
     path = meshio.read(tmp_path / "static_path.vtu")
     assert path.points.shape == (profiles.sizes["md"], 3)
     bottom = well_of(load_scene(VBH), 3000.0).trajectory.positions([3000.0])[0]
-    assert path.points[-1] == pytest.approx(bottom, abs=1e-9)
+    assert path.points[-1] == pytest.approx(bottom, abs=1e-9)  # v = w = 0 at the bit: the axis, to round-off
     assert path.point_data["lateral_displacement"].max() < 0.03  # within the largest clearance
