@@ -118,7 +118,10 @@ class Contact:
                                    "(as model.laws says)", choices=("model", "consistent", "printed"))
     damper_law: str = key("consistent", "the damper of (17): 'consistent' (c |delta|^3 delta_dot), 'printed' or "
                           "'model'", choices=("model", "consistent", "printed"))
-    sliding_velocity_scale: float = _pos("slip speed v_s of the regularised Coulomb law tanh(|s| / v_s) [m/s]", 1e-5)
+    sliding_velocity_scale: float = _pos("slip speed v_s of the regularised signs tanh(x / v_s) of the paper's "
+                                         "friction laws (18)-(19) [m/s]", 1e-5)
+    stick_stiffness: float = _pos("k_t of the Coulomb force's stuck contact (return mapping): the wall's "
+                                  "tangential spring below mu |F_n| [N/m]", 1e8)
     culling: bool = key(True, "evaluate the wall law only where a vertex can reach the wall (exact)")
 
 @dataclass(frozen=True)

@@ -31,10 +31,11 @@ GRAVITY, WALL, BIT_ROCK, DAMPING = 0, 1, 2, 3
 _KINDS = {Gravity: GRAVITY, WallContact: WALL, BitRock: BIT_ROCK, OutOfBandDamping: DAMPING}
 
 #: What :func:`residual_at` gives of a wall and a bit the model does not have.
-NO_WALL = (np.empty(0), np.empty((0, 4)), np.empty((0, 4, 3)), 0.0, np.empty(0), np.empty((0, 2)), np.empty((0, 4)))
+NO_WALL = (np.empty(0), np.empty((0, 4)), np.empty((0, 4, 3)), 0.0, np.empty(0), np.empty((0, 4)), np.empty((0, 4)))
 NO_BIT = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 #: The wall law's constants (:meth:`WallContact._law`'s order and types) of a model without a wall.
-NO_WALL_LAW = (np.empty(0), 0.0, 0.0, 0.0, False, 0.0, 0.0, np.empty(0), 0.0, False)
+NO_WALL_LAW = (np.empty(0), 0.0, 0.0, 0.0, False, 0.0, 0.0, np.empty(0), 0.0, False, 0.0, np.empty((0, 4)),
+               np.empty((0, 2)), False)
 
 
 @njit(cache=True)
@@ -72,7 +73,7 @@ def residual_at(internal, forces, order, constraints, drive_loads, q, qd, qdd, m
         elif kind == WALL:
             within = np.dot(column_bound, np.abs(q - q_ref)) < reach
             wall = WALL_PASS(wall_rows, q.size, q, qd, law[0], law[1], law[2], law[3], law[4], law[5], law[6], law[7],
-                             law[8], law[9])
+                             law[8], law[9], law[10], law[11], law[12], law[13])
             external += wall[4]
         elif kind == BIT_ROCK:
             rates = np.dot(bit_rows, qd)
@@ -94,7 +95,7 @@ class CompiledResidual:
     def __init__(self, model, internal: tuple, order: np.ndarray, drive_loads: np.ndarray):
         self.model, self.internal, self.order, self.drive_loads = model, internal, order, drive_loads
         self.wall = model.force(WallContact.name)
-        self._forces = (None, None)  # (the wall's vertex set, the forces' data for it) last given
+        self._forces = (None, None)  # ((the wall's vertex set, its memory), the forces' data for them) last given
 
     @classmethod
     def of(cls, model) -> "CompiledResidual | None":
@@ -109,12 +110,15 @@ class CompiledResidual:
 
     def forces(self):
         """The forces' data of :func:`residual_at` now (the wall's culled vertices are the last evaluation's),
-        or None if the wall has culled none yet; formed again only when the wall's vertex set has changed."""
+        or None if the wall has culled none yet; formed again only when the wall's vertex set or its friction's
+        memory has changed."""
         vertices = self.wall.evaluated_vertices() if self.wall is not None else None
         if self.wall is not None and vertices is None:
             return None
-        if self._forces[1] is None or vertices is not self._forces[0]:
-            self._forces = (vertices, self._formed_forces(vertices))
+        memory = self.wall.memory() if self.wall is not None else None
+        key = self._forces[0]
+        if self._forces[1] is None or vertices is not key[0] or memory is not key[1]:
+            self._forces = ((vertices, memory), self._formed_forces(vertices))
         return self._forces[1]
 
     def _formed_forces(self, vertices) -> tuple:

@@ -148,7 +148,7 @@ def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
     model = prepare(scene, dynamics=False).model
     resting = solve_static(model).q  # on the wall near the bit
     wall = model.force("wall")
-    flat, lateral_rows, packed = wall.every.flat, wall.every.lateral_rows, wall.every.packed
+    flat, packed = wall.every.flat, wall.every.packed
     # the rows packed by field, scattered back, are the dense ones, on fewer columns (the kernel reads only those)
     assert np.array_equal(packed.dense(), flat)
     assert packed.counts.max() < flat.shape[1]
@@ -158,16 +158,16 @@ def test_the_wall_pass_of_a_modal_space_is_the_law_at_its_positions_projected():
     for _ in range(20):
         q = resting * (1 + 0.05 * rng.standard_normal(model.size))
         qd = rng.standard_normal(model.size) * 0.5
-        delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(packed.kernel_data(), model.size, q,
-                                                                                 qd, *wall._law())
+        delta, nodal, laws, potential, generalised, positions, rates = _modal_pass(packed.kernel_data(), model.size,
+                                                                                   q, qd, *wall._law())
         projected = _projected_laws(packed.kernel_data(), model.size, delta, laws)
         # (1) positions and rates
-        position_bound = terms * eps * (np.abs(lateral_rows) @ np.abs(q)).reshape(-1, 2)
+        position_bound = terms * eps * (np.abs(flat) @ np.abs(q)).reshape(-1, 4)
         rate_bound = terms * eps * (np.abs(flat) @ np.abs(qd)).reshape(-1, 4)
-        assert np.all(np.abs(lateral - (lateral_rows @ q).reshape(-1, 2)) <= position_bound)
+        assert np.all(np.abs(positions - (flat @ q).reshape(-1, 4)) <= position_bound)
         assert np.all(np.abs(rates - (flat @ qd).reshape(-1, 4)) <= rate_bound)
         # (2) the law at those positions and rates
-        ref_delta, ref_nodal, ref_laws, ref_potential = _vertex_loads(lateral, rates, *wall._law())
+        ref_delta, ref_nodal, ref_laws, ref_potential = _vertex_loads(positions, rates, *wall._law())
         np.testing.assert_allclose(delta, ref_delta, rtol=0, atol=1e-11 * np.abs(ref_delta).max())
         np.testing.assert_allclose(nodal, ref_nodal, rtol=0, atol=1e-11 * np.abs(ref_nodal).max())
         np.testing.assert_allclose(laws, ref_laws, rtol=0, atol=1e-11 * np.abs(ref_laws).max())
@@ -224,9 +224,9 @@ def test_the_wall_tangent_of_a_modal_space_is_its_double_precision_product_to_si
         forces = wall.evaluate(q, qd, with_tangent=True)
         c_u, c_v = 1.0, 1e3
         tangent = wall.fresh().tangent(forces, c_u, c_v)  # formed whole (no kept tangent to update)
-        flat, lateral, rates, vertices = forces.tangent_data
+        flat, positions, rates, vertices = forces.tangent_data
         active = np.flatnonzero(forces.delta > 0)
-        blocks = _contact_blocks(active, lateral, rates, *wall._law(vertices), c_u, c_v)
+        blocks = _contact_blocks(active, positions, rates, *wall._law(vertices), c_u, c_v)
         rows = flat.reshape(-1, 4, model.size)[active]  # (vertex, field, column)
         weighted = np.einsum("vof,vfj->voj", blocks, rows)
         reference = np.einsum("voi,voj->ij", rows, weighted)

@@ -21,7 +21,7 @@ def test_an_interrupt_that_arrives_inside_a_kernel_is_a_keyboard_interrupt():
     into a loop of wall-law kernels, each must come out as KeyboardInterrupt (before the fix about
     three in four came out as SystemError).  A loop that no signal reaches ends after 200000 calls (a few
     seconds) and fails: nothing here can hang."""
-    lateral, rates = np.ones((3000, 2)), np.ones((3000, 4))
+    positions, rates = np.ones((3000, 4)), np.ones((3000, 4))
     gap, arm = np.full(3000, 0.5), np.full(3000, 0.1)  # the clearance and the torque arm at each vertex
     previous = signal.signal(signal.SIGUSR1, interrupt)
     try:
@@ -30,7 +30,8 @@ def test_an_interrupt_that_arrives_inside_a_kernel_is_a_keyboard_interrupt():
             timer.start()
             with pytest.raises(KeyboardInterrupt):
                 for _ in range(200000):
-                    _vertex_loads(lateral, rates, gap, 1.0, 1.0, 1.0, False, 0.2, 0.2, arm, 1e-4, True)
+                    _vertex_loads(positions, rates, gap, 1.0, 1.0, 1.0, False, 0.2, 0.2, arm, 1e-4, True, 1e10,
+                                  positions, np.zeros((3000, 2)), True)
             timer.join()
     finally:
         signal.signal(signal.SIGUSR1, previous)

@@ -5,10 +5,19 @@ by one of two laws (``contact.friction_model``):
 
 - ``coulomb`` (the default): one Coulomb force at the contact point, opposing the slip velocity of the pipe's
   surface against the wall, s = (u_dot, t . (v_dot, w_dot) + R_ext theta_x_dot), with t the wall's tangent in
-  the cross-section: F = -mu |F_n| tanh(|s| / v_s) s / |s|.  It acts as an axial force, a lateral force along t
-  and a torque R_ext F_t about the pipe's axis, and never does positive work (power -mu |F_n| |s| tanh(|s|/v_s)).
-  So rotation takes the drag away (the axial share is u_dot / |s|), and the string can climb the wall, roll
-  and whirl.
+  the cross-section, with |F| <= mu |F_n|.  It is computed by return mapping (Simo & Hughes 1998, Sec. 1.2;
+  Wriggers 2006, Sec. 5.2): over a step the contact point's slip g since the step's start loads a stiff tangential
+  spring k_t (``contact.stick_stiffness``) from the force F_0 the vertex held then, F* = F_0 - k_t g, and the force
+  is F* while |F*| <= mu |F_n| (stick; the spring's give is mu |F_n| / k_t, 0.6 um on the paper's string) and
+  mu |F_n| F* / |F*| otherwise (slip, opposing it).  It acts as an axial force, a lateral force along t and a
+  torque R_ext F_t about the pipe's axis.  So rotation takes the drag away (the axial share is u_dot / |s|), and
+  the string can climb the wall, roll and whirl.  Stick and slip are each linear or constant in the step's
+  unknowns, where a velocity regularisation tanh(|s| / v_s) is neither on the scale of v_s.  k_t = 1e8 N/m puts
+  the switch between them on the scale of a Newton update (1e-7 - 1e-6 m): at 1e10 N/m, as stiff as the wall,
+  a 1000 m string whose far part stops spinning under friction all at once (0.16-0.26 s after the start) had
+  hundreds of vertices switch within 1e-8 m, Newton's line search stalled on the switches and the step
+  collapsed (500 steps and 5000 iterations where 1e8 N/m takes 40 and 500); the paper's nominal scene gives
+  the same rop and efficiency at both to 1e-6.
 - ``paper``: (18) and (19) as two separate laws, -mu |F_n| sgn(u_dot) and -mu |F_n| R_bh sgn(theta_x_dot), with
   the borehole radius as the torque's arm (docs/errata.md); their signs as printed are a further option.
 
@@ -35,7 +44,7 @@ from fenics_drill.model.discretization import V as V_FIELD
 from fenics_drill.model.discretization import W as W_FIELD
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
-from fenics_drill.model.kernels.packed_rows import FieldPackedRows, add_row, dot_row, dot_row_twice, gathered, scatter
+from fenics_drill.model.kernels.packed_rows import FieldPackedRows, add_row, dot_row_twice, gathered, scatter
 from fenics_drill.scene import LAW_SIGN
 
 FIELDS = (U_FIELD, V_FIELD, W_FIELD, TX_FIELD)  # the fields the wall acts on: F_a, F_v, F_w, T_FS
@@ -123,45 +132,54 @@ _FRICTION = np.vectorize(_friction, otypes=(float, float))
 
 
 @njit(cache=True, inline="always")
-def _slip_factor(slip, velocity_scale):
-    """g(|s|) = tanh(|s| / v_s) / |s|, the regularised Coulomb force being -mu |F_n| g s, and (dg/d|s|) / |s|
-    (its derivative is -mu |F_n| (g I + (dg/d|s|) / |s| s s^T)); both finite at s = 0."""
-    y = slip / velocity_scale
-    if y < 1e-4:  # the series of tanh(y) / y: 1 - y^2 / 3
-        return (1.0 - y * y / 3.0) / velocity_scale, -2.0 / (3.0 * velocity_scale**3)
-    if y > SATURATED:
-        return 1.0 / slip, -1.0 / slip**3
-    th = np.tanh(y)
-    g = th / slip
-    return g, ((1.0 - th * th) / velocity_scale - g) / (slip * slip)
+def _return_map(normal_force, held_axial, held_tangential, axial_slip, tangential_slip, friction, stick_stiffness):
+    """The Coulomb force at the contact point after a slip (g_a, g_t) of the contact point since the step's start,
+    by return mapping: the trial force of the stuck contact, F* = F_n - k_t g (F_n: the force at the step's start),
+    kept if |F*| <= mu |F_n| (stick), else scaled back onto the cone, mu |F_n| F* / |F*| (slip).  Returns
+    (F_a, F_t, |F*|)."""
+    trial_a = held_axial - stick_stiffness * axial_slip
+    trial_t = held_tangential - stick_stiffness * tangential_slip
+    size = np.hypot(trial_a, trial_t)
+    cap = friction * abs(normal_force)
+    if size <= cap:
+        return trial_a, trial_t, size
+    return cap * trial_a / size, cap * trial_t / size, size
+
+
+def coulomb_friction(normal_force, held_axial, held_tangential, axial_slip, tangential_slip, friction,
+                     stick_stiffness):
+    """One Coulomb force at the contact point, by return mapping (:func:`_return_map`): (F_a, F_t) with
+    |F| <= mu |F_n|, the stuck contact's spring k_t below it and the cone's surface, opposing the trial's slip,
+    above."""
+    return _COULOMB(normal_force, held_axial, held_tangential, axial_slip, tangential_slip, friction,
+                    stick_stiffness)[:2]
+
+
+_COULOMB = np.vectorize(_return_map, otypes=(float, float, float))
 
 
 @njit(cache=True, inline="always")
-def _coulomb(normal_force, axial_slip, tangential_slip, friction, velocity_scale):
-    """The Coulomb force at the contact point, (F_a, F_t) = -mu |F_n| tanh(|s| / v_s) s / |s|."""
-    g = _slip_factor(np.hypot(axial_slip, tangential_slip), velocity_scale)[0]
-    magnitude = friction * abs(normal_force)
-    return -magnitude * g * axial_slip, -magnitude * g * tangential_slip
-
-
-def coulomb_friction(normal_force, axial_slip, tangential_slip, friction, velocity_scale):
-    """One Coulomb force opposing the slip velocity of the contact point (axial and tangential components):
-    (F_a, F_t) = -mu |F_n| tanh(|s| / v_s) s / |s|.  Its magnitude is mu |F_n| tanh(|s| / v_s) <= mu |F_n|."""
-    return _COULOMB(normal_force, axial_slip, tangential_slip, friction, velocity_scale)
-
-
-_COULOMB = np.vectorize(_coulomb, otypes=(float, float))
+def _contact_slip(i, v, w, n_v, n_w, positions, anchor, arm):
+    """(g_a, g_t): the contact point's slip since the step's start, axial and along the wall's tangent
+    t = (-n_w, n_v): the axial move, and t . (v, w) plus the pipe's surface turned, R_ext theta_x, from the
+    anchor (the vertex's (u, v, w, theta_x) at the step's start)."""
+    g_a = positions[i, 0] - anchor[i, 0]
+    g_t = -n_w * (v - anchor[i, 1]) + n_v * (w - anchor[i, 2]) + arm[i] * (positions[i, 3] - anchor[i, 3])
+    return g_a, g_t
 
 
 @njit(cache=True, inline="always")
-def _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s, coulomb, delta,
-                nodal, laws):
-    """Eqs. (16)-(19) at vertex i with lateral position (v, w) and rates (u, v, w, theta_x)_dot (row i of
-    ``rates``, read in place: a row view per vertex costs more than the law out of contact): its
-    indentation, nodal loads and the loads of each law (the damper; the axial friction; the friction torque, or
-    with ``coulomb`` the tangential part of the one friction force, lateral and torque); returns the springs'
-    energy.  ``gap``: each vertex's clearance; ``arm``: each vertex's friction torque's arm, its contact radius
-    for the Coulomb force at the contact point, R_bh in (19)."""
+def _vertex_law(i, positions, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s, coulomb,
+                stick_stiffness, anchor, held, sticking, delta, nodal, laws):
+    """Eqs. (16)-(19) at vertex i with position (u, v, w, theta_x) (row i of ``positions``) and rates (their
+    time derivatives, row i of ``rates``; both read in place: a row view per vertex costs more than the law out of
+    contact): its indentation, nodal loads and the loads of each law (the damper; the axial friction; the
+    friction torque, or with ``coulomb`` the tangential part of the one friction force, lateral and torque);
+    returns the springs' energy.  ``gap``: each vertex's clearance; ``arm``: each vertex's friction torque's arm,
+    its contact radius for the Coulomb force at the contact point, R_bh in (19).  The Coulomb force
+    (:func:`_return_map`) starts from each vertex's ``anchor`` and ``held`` force at the step's start; without
+    ``sticking`` (no step under way: a static state) it is zero."""
+    v, w = positions[i, 1], positions[i, 2]
     r = np.hypot(v, w)
     d = r - gap[i]
     delta[i] = d
@@ -172,8 +190,10 @@ def _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torq
     damper = normal + k1 * d + k2 * d**3  # with the clip that keeps the wall from pulling
     laws[i, 1, 0], laws[i, 2, 0] = damper * n_v, damper * n_w
     if coulomb:  # t = (-n_w, n_v): the wall's tangent, the direction the contact point turns with theta_x
-        tangential_slip = -n_w * rates[i, 1] + n_v * rates[i, 2] + arm[i] * rates[i, 3]
-        axial, tangential = _coulomb(normal, rates[i, 0], tangential_slip, mu_axial, v_s)
+        axial = tangential = 0.0
+        if sticking:
+            g_a, g_t = _contact_slip(i, v, w, n_v, n_w, positions, anchor, arm)
+            axial, tangential, _ = _return_map(normal, held[i, 0], held[i, 1], g_a, g_t, mu_axial, stick_stiffness)
         nodal[i, 0], nodal[i, 3] = axial, arm[i] * tangential
         nodal[i, 1], nodal[i, 2] = normal * n_v - tangential * n_w, normal * n_w + tangential * n_v
         laws[i, 0, 1] = axial
@@ -187,20 +207,23 @@ def _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torq
 
 
 @kernel
-def _vertex_loads(lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s, coulomb):
-    """Eqs. (16)-(19) at every vertex: indentation, nodal loads (F_a, F_v, F_w, T), the loads of the
-    damper and of the two parts of friction (vertex, field, law), and the springs' energy."""
-    n = lateral.shape[0]
+def _vertex_loads(positions, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s, coulomb,
+                  stick_stiffness, anchor, held, sticking):
+    """Eqs. (16)-(19) at every vertex of (u, v, w, theta_x) ``positions`` and their ``rates``: indentation, nodal
+    loads (F_a, F_v, F_w, T), the loads of the damper and of the two parts of friction (vertex, field, law), and
+    the springs' energy."""
+    n = positions.shape[0]
     delta, nodal, laws = np.empty(n), np.zeros((n, 4)), np.zeros((n, 4, 3))
     potential = 0.0
     for i in range(n):
-        potential += _vertex_law(i, lateral[i, 0], lateral[i, 1], rates, gap, k1, k2, damping, printed,
-                                 mu_axial, mu_torque, arm, v_s, coulomb, delta, nodal, laws)
+        potential += _vertex_law(i, positions, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm,
+                                 v_s, coulomb, stick_stiffness, anchor, held, sticking, delta, nodal, laws)
     return delta, nodal, laws, potential
 
 
 @kernel(fastmath=REASSOCIATE)
-def _modal_pass(packed, size, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s, coulomb):
+def _modal_pass(packed, size, q, qd, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s, coulomb,
+                stick_stiffness, anchor, held, sticking):
     """:func:`_vertex_loads` in a modal space (``size`` coordinates), in one pass over the rows of [Phi] of
     (u, v, w, theta_x) at each vertex, interleaved and packed by field (``packed``: :meth:`~fenics_drill.model.
     packed_rows.FieldPackedRows.kernel_data`, groups in the order of FIELDS): each vertex's positions and
@@ -210,22 +233,22 @@ def _modal_pass(packed, size, q, qd, gap, k1, k2, damping, printed, mu_axial, mu
     values, _, columns, counts = packed
     n = values.shape[0] // 4
     q_at, qd_at = gathered(q, columns), gathered(qd, columns)
-    q_v, q_w, qd_u, qd_v, qd_w, qd_t = q_at[1], q_at[2], qd_at[0], qd_at[1], qd_at[2], qd_at[3]
+    q_u, q_v, q_w, q_t = q_at[0], q_at[1], q_at[2], q_at[3]
+    qd_u, qd_v, qd_w, qd_t = qd_at[0], qd_at[1], qd_at[2], qd_at[3]
     c_u, c_v, c_w, c_t = counts[0], counts[1], counts[2], counts[3]
     loads = np.zeros(columns.shape)
     load_u, load_v, load_w, load_t = loads[0], loads[1], loads[2], loads[3]
     delta, nodal, laws = np.empty(n), np.zeros((n, 4)), np.zeros((n, 4, 3))
-    lateral, rates = np.empty((n, 2)), np.empty((n, 4))
+    positions, rates = np.empty((n, 4)), np.empty((n, 4))
     potential = 0.0
     for i in range(n):
         r = 4 * i
-        v, rate_v = dot_row_twice(values, r + 1, q_v, qd_v, c_v)
-        w, rate_w = dot_row_twice(values, r + 2, q_w, qd_w, c_w)
-        lateral[i, 0], lateral[i, 1] = v, w
-        rates[i, 0], rates[i, 1] = dot_row(values, r, qd_u, c_u), rate_v
-        rates[i, 2], rates[i, 3] = rate_w, dot_row(values, r + 3, qd_t, c_t)
-        potential += _vertex_law(i, v, w, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s,
-                                 coulomb, delta, nodal, laws)
+        positions[i, 0], rates[i, 0] = dot_row_twice(values, r, q_u, qd_u, c_u)
+        positions[i, 1], rates[i, 1] = dot_row_twice(values, r + 1, q_v, qd_v, c_v)
+        positions[i, 2], rates[i, 2] = dot_row_twice(values, r + 2, q_w, qd_w, c_w)
+        positions[i, 3], rates[i, 3] = dot_row_twice(values, r + 3, q_t, qd_t, c_t)
+        potential += _vertex_law(i, positions, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s,
+                                 coulomb, stick_stiffness, anchor, held, sticking, delta, nodal, laws)
         if delta[i] > 0.0:
             add_row(load_u, values, r, nodal[i, 0], c_u)
             add_row(load_v, values, r + 1, nodal[i, 1], c_v)
@@ -233,7 +256,7 @@ def _modal_pass(packed, size, q, qd, gap, k1, k2, damping, printed, mu_axial, mu
             add_row(load_t, values, r + 3, nodal[i, 3], c_t)
     generalised = np.zeros(size)
     scatter(generalised, columns, counts, loads)
-    return delta, nodal, laws, potential, generalised, lateral, rates
+    return delta, nodal, laws, potential, generalised, positions, rates
 
 
 #: :func:`_modal_pass` itself, for compiled code that evaluates the wall (solvers/compiled_residual.py).
@@ -260,14 +283,14 @@ def _projected_laws(packed, size, delta, laws):
 
 
 @kernel
-def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s, coulomb,
-                    c_u, c_v):
+def _contact_blocks(active, positions, rates, gap, k1, k2, damping, printed, mu_axial, mu_torque, arm, v_s, coulomb,
+                    stick_stiffness, anchor, held, sticking, c_u, c_v):
     """c_u d(F_a, F_v, F_w, T)/d(u, v, w, theta_x) + c_v d(...)/d(velocities) at every vertex in contact:
     one 4 x 4 block per vertex, rows and columns in the order of FIELDS."""
     blocks = np.zeros((active.size, 4, 4))
     for k in range(active.size):
         i = active[k]
-        v, w = lateral[i, 0], lateral[i, 1]
+        v, w = positions[i, 1], positions[i, 2]
         r = np.hypot(v, w)
         d = r - gap[i]
         n_v, n_w = v / r, w / r
@@ -283,8 +306,8 @@ def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_ax
         dfn_v = c_u * (spring * n_v + damper_by_rate * (dv - d_rate * n_v) / r) + c_v * damper_by_rate * n_v
         dfn_w = c_u * (spring * n_w + damper_by_rate * (dw - d_rate * n_w) / r) + c_v * damper_by_rate * n_w
         if coulomb:
-            _coulomb_block(blocks[k], normal, dfn_v, dfn_w, n_v, n_w, r, d_rate, dv, dw, rates[i, 0], rates[i, 3],
-                           mu_axial, arm[i], v_s, c_u, c_v)
+            _coulomb_block(blocks[k], i, normal, dfn_v, dfn_w, n_v, n_w, r, positions, anchor, held, sticking,
+                           mu_axial, arm, stick_stiffness, c_u)
             continue
         radius_bh = arm[i]
         s_a = _regularised_sign(rates[i, 0], v_s)
@@ -304,36 +327,54 @@ def _contact_blocks(active, lateral, rates, gap, k1, k2, damping, printed, mu_ax
 
 
 @njit(cache=True, inline="always")
-def _coulomb_block(b, normal, dfn_v, dfn_w, n_v, n_w, r, d_rate, dv, dw, du, dtheta, mu, arm, v_s, c_u, c_v):
-    """The 4 x 4 block of the normal force and the Coulomb force at the contact point, c_u d/dq + c_v d/dq_dot of
-    (F_a, F_v, F_w, T) by (u, v, w, theta_x), written into ``b``.  With t = (-n_w, n_v), the slip
-    s = (u_dot, t . (v_dot, w_dot) + R theta_x_dot), F = -M g(|s|) s, M = mu |F_n|, g of :func:`_slip_factor`:
-    dF = -dM g s - M (g I + gamma s s^T) ds, with d t / d(v, w) = (n_v n_w, -n_v^2; n_w^2, -n_v n_w) / r and
-    d s_t / d(v, w) = (n_w, -n_v) delta_dot / r."""
+def _coulomb_block(b, i, normal, dfn_v, dfn_w, n_v, n_w, r, positions, anchor, held, sticking, mu, arm,
+                   stick_stiffness, c_u):
+    """The 4 x 4 block of the normal force and the Coulomb force at the contact point of vertex i, c_u d/dq +
+    c_v d/dq_dot of (F_a, F_v, F_w, T) by (u, v, w, theta_x) (the c_v part is the damper's, in ``dfn_v``,
+    ``dfn_w``), written into ``b``.  With t = (-n_w, n_v), d t / d(v, w) = (n_v n_w, -n_v^2; n_w^2, -n_v n_w) / r
+    and the slip g of :func:`_contact_slip`, the trial force F* = F_n - k_t g moves by dF* = -k_t dg; stuck,
+    dF = dF*; slipping (F = M e, M = mu |F_n|, e = F* / |F*|), dF = dM e + M (I - e e^T) dF* / |F*|."""
     t_v, t_w = -n_w, n_v
-    s_a, s_t = du, t_v * dv + t_w * dw + arm * dtheta
-    g, gamma = _slip_factor(np.hypot(s_a, s_t), v_s)
     magnitude = -mu * normal
-    f_t = -magnitude * g * s_t
-    j_aa, j_at, j_tt = g + gamma * s_a * s_a, gamma * s_a * s_t, g + gamma * s_t * s_t
+    sticking = sticking and magnitude > 0.0  # no friction: the normal force's block alone
+    f_a = f_t = size = 0.0
+    g_v = g_w = 0.0
+    if sticking:
+        g_v, g_w = positions[i, 1] - anchor[i, 1], positions[i, 2] - anchor[i, 2]
+        g_a, g_t = _contact_slip(i, positions[i, 1], positions[i, 2], n_v, n_w, positions, anchor, arm)
+        f_a, f_t, size = _return_map(normal, held[i, 0], held[i, 1], g_a, g_t, mu, stick_stiffness)
+    slipping = sticking and size > magnitude
+    e_a, e_t = (f_a / magnitude, f_t / magnitude) if slipping else (0.0, 0.0)
+    shrink = magnitude / size if slipping else 1.0
     turn = c_u / r
     for j in range(4):
-        ds_a = c_v if j == 0 else 0.0
         if j == 1:
-            ds_t, dfn = turn * n_w * d_rate + c_v * t_v, dfn_v
-            dn_v, dn_w = turn * n_w * n_w, -turn * n_v * n_w
+            dfn, dn_v, dn_w = dfn_v, turn * n_w * n_w, -turn * n_v * n_w
         elif j == 2:
-            ds_t, dfn = -turn * n_v * d_rate + c_v * t_w, dfn_w
-            dn_v, dn_w = -turn * n_v * n_w, turn * n_v * n_v
+            dfn, dn_v, dn_w = dfn_w, -turn * n_v * n_w, turn * n_v * n_v
         else:
-            ds_t, dfn, dn_v, dn_w = (c_v * arm if j == 3 else 0.0), 0.0, 0.0, 0.0
-        d_magnitude = -mu * dfn
-        df_a = -(d_magnitude * g * s_a + magnitude * (j_aa * ds_a + j_at * ds_t))
-        df_t = -(d_magnitude * g * s_t + magnitude * (j_at * ds_a + j_tt * ds_t))
+            dfn, dn_v, dn_w = 0.0, 0.0, 0.0
+        df_a = df_t = 0.0
+        if sticking:
+            # d g = (du, t . d(v, w) + d t . (v - v0, w - w0) + R d theta_x), dt = (-dn_w, dn_v)
+            dg_a = c_u if j == 0 else 0.0
+            dg_t = -dn_w * g_v + dn_v * g_w
+            if j == 1:
+                dg_t += c_u * t_v
+            elif j == 2:
+                dg_t += c_u * t_w
+            elif j == 3:
+                dg_t += c_u * arm[i]
+            df_a, df_t = -stick_stiffness * dg_a, -stick_stiffness * dg_t
+            if slipping:
+                along = e_a * df_a + e_t * df_t
+                d_magnitude = -mu * dfn
+                df_a = d_magnitude * e_a + shrink * (df_a - along * e_a)
+                df_t = d_magnitude * e_t + shrink * (df_t - along * e_t)
         b[0, j] = df_a
         b[1, j] = dfn * n_v + normal * dn_v + df_t * t_v - f_t * dn_w
         b[2, j] = dfn * n_w + normal * dn_w + df_t * t_w + f_t * dn_v
-        b[3, j] = arm * df_t
+        b[3, j] = arm[i] * df_t
 
 
 @kernel
@@ -560,6 +601,7 @@ class WallContact:
         self.mu_axial = law_sign[0] * contact.friction
         self.mu_torque = law_sign[1] * contact.friction
         self.v_s = contact.sliding_velocity_scale
+        self.stick_stiffness = contact.stick_stiffness
         # the rows of [Phi] of (u, v, w, theta_x) at every vertex, interleaved: row 4 i + k is field k at
         # vertex i, so one product gives all four fields at all vertices and projects all their forces
         by_field = [space.rows(disc.vertex_dofs(f)) for f in FIELDS]
@@ -580,6 +622,9 @@ class WallContact:
         self.culling = culling
         self._near = None  # the VertexSet of the last culled evaluation
         self._kept_tangent = None  # (matrix, blocks, updates) of the modal tangent (:meth:`_updated_tangent`)
+        # the Coulomb force's memory at the last accepted state: each vertex's (u, v, w, theta_x) and friction
+        # (F_a, F_t); None outside a run (a static state: no friction)
+        self._history = None
 
     @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "WallContact":
@@ -596,19 +641,46 @@ class WallContact:
         return scaled
 
     def fresh(self) -> "WallContact":
-        """A copy whose modal tangent is formed afresh (a simulation's results never depend on another's)."""
+        """A copy whose modal tangent is formed afresh and whose friction has no memory yet (a simulation's results
+        never depend on another's)."""
         changed = copy.copy(self)
         changed._kept_tangent = None
+        changed._history = None
         return changed
+
+    def begin(self, t: float, q: np.ndarray) -> None:
+        """Start the Coulomb force's memory at the initial state: anchored at q, no force yet."""
+        if self.coulomb:
+            self._history = ((self.flat @ q).reshape(-1, len(FIELDS)), np.zeros((len(self.x), 2)))
+
+    def accept(self, t: float, q: np.ndarray, qd: np.ndarray) -> None:
+        """Anchor the Coulomb force at an accepted state, holding the force each vertex feels there."""
+        if not self.coulomb or self._history is None:
+            return
+        positions = (self.flat @ q).reshape(-1, len(FIELDS))
+        rates = (self.flat @ qd).reshape(-1, len(FIELDS))
+        _, nodal, _, _ = _vertex_loads(positions, rates, *self._law())
+        self._history = (positions, np.column_stack([nodal[:, 0], nodal[:, 3] / self.arm]))
 
     def record(self, forces: "WallForces") -> dict[str, float]:
         return {"vertices_in_contact": int(np.count_nonzero(forces.delta > 0))}
 
     def _law(self, vertices: np.ndarray | None = None) -> tuple:
-        """The law's constants at ``vertices`` (default: all), in the order the compiled kernels take them."""
+        """The law's constants at ``vertices`` (default: all), with the Coulomb force's memory there, in the order
+        the compiled kernels take them."""
         at = slice(None) if vertices is None else vertices
+        history = self._history
+        count = len(self.x) if vertices is None else len(vertices)
+        anchor, held = (np.zeros((count, len(FIELDS))), np.zeros((count, 2))) if history is None else \
+            (np.ascontiguousarray(history[0][at]), np.ascontiguousarray(history[1][at]))
         return (np.ascontiguousarray(self.gap[at]), self.k1, self.k2, self.c, self.damper_law == "printed",
-                self.mu_axial, self.mu_torque, np.ascontiguousarray(self.arm[at]), self.v_s, self.coulomb)
+                self.mu_axial, self.mu_torque, np.ascontiguousarray(self.arm[at]), self.v_s, self.coulomb,
+                self.stick_stiffness, anchor, held, history is not None)
+
+    def memory(self):
+        """What the law's constants depend on besides the vertices: the Coulomb force's memory (its identity
+        changes at each accepted step)."""
+        return self._history
 
     #: Vertices within this share of the gap from the wall are evaluated; the others are left out until
     #: q has moved enough, by the bound of :meth:`_near_vertices`, to possibly bring one of them to it.
@@ -643,24 +715,25 @@ class WallContact:
         when read.  The indentation is -inf at the vertices left out."""
         vertex_set = self._near_vertices(q) if self.culling else self.every
         if sp.issparse(vertex_set.flat):  # the full space: the rows select dofs
-            lateral = (vertex_set.lateral_rows @ q).reshape(-1, 2)
+            positions = (vertex_set.flat @ q).reshape(-1, len(FIELDS))
             rates = (vertex_set.flat @ qd).reshape(-1, len(FIELDS))
-            delta, nodal, laws, potential = _vertex_loads(lateral, rates, *self._law(vertex_set.vertices))
+            delta, nodal, laws, potential = _vertex_loads(positions, rates, *self._law(vertex_set.vertices))
             generalised = np.asarray(vertex_set.flat.T @ nodal.ravel())
         else:
-            delta, nodal, laws, potential, generalised, lateral, rates = _modal_pass(
+            delta, nodal, laws, potential, generalised, positions, rates = _modal_pass(
                 vertex_set.packed.kernel_data(), q.size, q, qd, *self._law(vertex_set.vertices))
-        return self.forces_of(vertex_set, (delta, nodal, laws, potential, generalised, lateral, rates), with_tangent)
+        return self.forces_of(vertex_set, (delta, nodal, laws, potential, generalised, positions, rates),
+                              with_tangent)
 
     def forces_of(self, vertex_set: VertexSet, passed: tuple, with_tangent: bool) -> WallForces:
         """The evaluation of the vertices ``vertex_set`` from what :func:`_modal_pass` gives for them (also what a
         compiled Newton step hands back: solvers/compiled_step.py)."""
-        delta, nodal, laws, potential, generalised, lateral, rates = passed
+        delta, nodal, laws, potential, generalised, positions, rates = passed
         by_law = ProjectedLaws(vertex_set, delta, laws, self.law_names)
         out = WallForces(generalised, potential, by_law, len(self.x), vertex_set.vertices, delta, nodal,
                          tangential_arm=self.arm if self.coulomb else None)
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
-            out.tangent_data = (vertex_set.flat, lateral, rates, vertex_set.vertices)
+            out.tangent_data = (vertex_set.flat, positions, rates, vertex_set.vertices)
         return out
 
     def evaluated_vertices(self) -> VertexSet:
@@ -688,11 +761,11 @@ class WallContact:
         Newton, and the residual, in double precision, decides when it has converged."""
         if forces.tangent_data is None:
             return None
-        flat, lateral, rates, vertices = forces.tangent_data
+        flat, positions, rates, vertices = forces.tangent_data
         active = np.flatnonzero(forces.delta > 0)
         if active.size == 0:
             return None
-        blocks = _contact_blocks(active, lateral, rates, *self._law(vertices), c_u, c_v)
+        blocks = _contact_blocks(active, positions, rates, *self._law(vertices), c_u, c_v)
         if sp.issparse(flat):  # the full space: each row of [Phi] selects one free dof (or none, at a support)
             columns, values = _selection(flat)
             at = len(FIELDS) * active[:, None] + np.arange(len(FIELDS))
