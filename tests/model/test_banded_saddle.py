@@ -86,7 +86,7 @@ def test_full_order_string_solves_as_scipy_sparse_lu():
     q = 1e-3 * rng.standard_normal(n)
     dt = 2.5e-3
     evaluation = model.evaluate(q, q, q, np.zeros(2), (1.0, 0.5 / (0.25 * dt), 1.0 / (0.25 * dt * dt)))
-    J, B = sp.csr_matrix(evaluation.tangent), np.asarray(model.constraints)
+    J, B = evaluation.tangent.tocsr(), np.asarray(model.constraints)
     k = abs(J.diagonal()).max()  # rows of [B] scaled to the tangent's: the bordered system is well posed
     bordered = sp.bmat([[J, sp.csr_matrix(k * B).T], [sp.csr_matrix(k * B), None]], format="csc")
     rhs_q, rhs_c = rng.standard_normal(n), 1e-3 * rng.standard_normal(2)

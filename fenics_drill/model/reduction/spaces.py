@@ -21,7 +21,7 @@ import scipy.sparse.linalg as spla
 from scipy.linalg.lapack import dgetrf as getrf
 from scipy.linalg.lapack import dgetrs as getrs
 
-from fenics_drill.model.kernels.banded_saddle import BandedSaddle
+from fenics_drill.model.kernels.banded_saddle import BandedSaddle, SparseSum
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.reduction.enrichment import MODE_SPAN_TOLERANCE, augment, climbing_friction, enrich
 from fenics_drill.model.reduction.modes import reduction_bands, select_modes, solve_modes, stuck_bit_modes
@@ -287,16 +287,11 @@ class FullSpace:
     def solve(self, matrix, rhs: np.ndarray) -> np.ndarray:
         return spla.spsolve(sp.csc_matrix(matrix), rhs)
 
-    def combine(self, terms) -> sp.coo_matrix:
-        """sum of c A over the (c, A) of ``terms``, as the entries of all terms side by side (a COO matrix
-        whose repeated entries add up): no sparse sums, whose bookkeeping costs more than the banded LU."""
-        parts = [matrix if isinstance(matrix, sp.coo_matrix) else sp.coo_matrix(matrix) for _, matrix in terms]
-        if not parts:
-            return sp.coo_matrix((self.size, self.size))
-        data = np.concatenate([c * part.data for (c, _), part in zip(terms, parts)])
-        rows = np.concatenate([part.row for part in parts])
-        columns = np.concatenate([part.col for part in parts])
-        return sp.coo_matrix((data, (rows, columns)), shape=(self.size, self.size))
+    def combine(self, terms) -> SparseSum:
+        """sum of c A over the (c, A) of ``terms``, kept as its terms (:class:`~fenics_drill.model.kernels.
+        banded_saddle.SparseSum`): no sparse sums, whose bookkeeping costs more than the banded LU, and a kept
+        term's band is laid out once."""
+        return SparseSum(terms, (self.size, self.size))
 
     def _factorise(self, tangent, constraints) -> BandedSaddle:
         return BandedSaddle(tangent, constraints, self._band_order, self._band_width)
