@@ -6,7 +6,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from fenics_drill.model.kernels.banded_saddle import BandedSaddle
+from fenics_drill.model.kernels.banded_saddle import BandedSaddle, SparseSum
 from fenics_drill.model.drillstring import build_model
 from conftest import scene_with
 
@@ -47,6 +47,38 @@ def test_banded_saddle_matches_a_dense_solve_of_the_bordered_system(seed):
     # 200 (measured for these seeds), so their difference is round-off, far below 1e-12 of the solution
     assert np.allclose(x, expected[:n], rtol=0, atol=1e-12 * np.abs(expected).max())
     assert np.allclose(mu, expected[n:], rtol=0, atol=1e-12 * np.abs(expected).max())
+
+
+def test_a_sum_kept_as_its_terms_solves_as_its_matrix_and_its_kept_layout_follows_no_stale_terms():
+    """A tangent as the model forms it, SparseSum([(1, kept sum of three parts), (-1, fresh part)]): the solve equals
+    the dense one of the summed matrix; a second tangent over the same kept sum with another fresh part (the kept
+    band copied, not laid out again) equals its own dense solve, and so does one under other held dofs."""
+    n, width = 60, 3
+    order = scrambled_band(n, width, 3)[2]
+    dense_parts = []  # five banded matrices in that one numbering; the first diagonally dominant
+    for k in range(5):
+        rng = np.random.default_rng(20 + k)
+        banded = sum(np.diag(rng.standard_normal(n - abs(d)), d) for d in range(-width, width + 1))
+        dense = np.zeros((n, n))
+        dense[np.ix_(order, order)] = banded + (np.diag(np.full(n, 12.0 * width)) if k == 0 else 0.0)
+        dense_parts.append(dense)
+    kept = SparseSum([(1.0, dense_parts[0]), (2.5, dense_parts[1]), (-0.5, dense_parts[2])], (n, n))
+    rng = np.random.default_rng(30)
+    for fresh in (dense_parts[3], dense_parts[4]):
+        for held in (rng.choice(n, size=2, replace=False), rng.choice(n, size=1, replace=False)):
+            tangent = SparseSum([(1.0, kept), (-1.0, sp.coo_matrix(fresh))], (n, n))
+            matrix = dense_parts[0] + 2.5 * dense_parts[1] - 0.5 * dense_parts[2] - fresh
+            assert np.allclose(tangent.toarray(), matrix, rtol=0, atol=1e-13)
+            assert np.allclose(tangent @ np.ones(n), matrix @ np.ones(n), rtol=0, atol=1e-12)
+            B = np.zeros((held.size, n))
+            B[np.arange(held.size), held] = 2.0
+            saddle = np.block([[matrix, B.T], [B, np.zeros((held.size, held.size))]])
+            rhs_q, rhs_c = rng.standard_normal(n), rng.standard_normal(held.size)
+            expected = np.linalg.solve(saddle, np.concatenate([rhs_q, rhs_c]))
+            x, mu = BandedSaddle(tangent, B, order, width)(rhs_q, rhs_c)
+            # direct solves of one well-conditioned system (diagonally dominant J): round-off apart
+            assert np.allclose(x, expected[:n], rtol=0, atol=1e-11 * np.abs(expected).max())
+            assert np.allclose(mu, expected[n:], rtol=0, atol=1e-11 * np.abs(expected).max())
 
 
 def test_a_constraint_on_two_dofs_is_refused():

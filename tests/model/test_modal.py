@@ -306,6 +306,11 @@ def test_the_modes_solved_by_field_groups_are_those_of_the_whole_problem():
     # M-orthonormal to round-off and solve_modes normalises again: measured 8e-16, allowed 1e-12 for sums over
     # ~150 dofs of vectors known to the eigensolver's residual
     assert basis.vectors.T @ mass @ basis.vectors == pytest.approx(np.eye(len(basis)), abs=1e-12)
+    # without the vectors (the full order's spectra): the same frequencies, kinds and energy fractions, exactly
+    bare = solve_modes(disc, 3.0, held=DRIVE, vectors=False)
+    assert bare.vectors is None
+    assert np.array_equal(bare.frequencies_hz, basis.frequencies_hz) and bare.kinds == basis.kinds
+    assert np.array_equal(bare.energy_fractions, basis.energy_fractions)
 
 
 def test_field_groups_merge_where_a_matrix_couples_two_fields():

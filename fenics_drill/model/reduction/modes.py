@@ -45,7 +45,7 @@ class ModalBasis:
     f_star: np.ndarray
     kinds: list[str]
     energy_fractions: np.ndarray  # (n_modes, 6): kinetic energy share of u, v, w, tx, ty, tz
-    vectors: np.ndarray  # (ndofs, n_modes)
+    vectors: np.ndarray | None  # (ndofs, n_modes); None: not kept (frequencies and kinds only)
 
     def __len__(self) -> int:
         return len(self.frequencies_hz)
@@ -54,7 +54,7 @@ class ModalBasis:
         idx = np.asarray(indices, dtype=int)
         return ModalBasis(
             self.frequencies_hz[idx], self.f_star[idx], [self.kinds[i] for i in idx],
-            self.energy_fractions[idx], self.vectors[:, idx],
+            self.energy_fractions[idx], None if self.vectors is None else self.vectors[:, idx],
         )
 
 
@@ -168,11 +168,13 @@ def _modes_of_block(K: PETSc.Mat, M: PETSc.Mat, dofs: np.ndarray, free_dofs: int
 
 
 def solve_modes(disc: BeamDiscretization, f_star_max: float, mass=None, held: tuple = (),
-                safety: float = 1.15) -> ModalBasis:
+                safety: float = 1.15, vectors: bool = True) -> ModalBasis:
     """All modes with f* = f L / c_L <= ``f_star_max`` (Eq. 95), sorted by frequency; ``mass`` is the
     assembled free-free M (SciPy) used to normalise and classify them (assembled here if not given).
     ``held`` adds (field, end) pairs to the supports: with :data:`~fenics_drill.model.discretization.DRIVE`,
     the modes of the string held by the drive as in a run (axial and torsional quarter waves).
+    ``vectors``: keep the eigenvectors (False: frequencies and kinds only, for the full order's spectra; the
+    modes of a band that grows with the length cost length^2 in memory, 0.7 GB at 3 km).
 
     The problem is solved for each group of fields that K and M couple (:func:`coupled_field_groups`: four
     for the straight string, a third of the cost of one solve of the whole); in each, the number of requested
@@ -183,38 +185,46 @@ def solve_modes(disc: BeamDiscretization, f_star_max: float, mass=None, held: tu
     c_L = p.longitudinal_wave_speed
     f_max = f_star_max * c_L / p.length
     K, M = assemble_modal_pair(disc, held)
-    mass = assemble_linear(disc).mass if mass is None else mass
+    mass = sp.csr_matrix(assemble_linear(disc).mass if mass is None else mass)
     # The target sits below zero so K - target*M is positive definite despite the rigid modes.
     target = -((2.0 * math.pi * 1e-3 * c_L / p.length) ** 2)
     estimates = estimated_mode_counts(disc, f_max)
     constrained = np.zeros(disc.ndofs, dtype=bool)
     constrained[np.asarray(disc.support_dofs, dtype=int)] = True
     constrained[[disc.end_dof(field, end) for field, end in held]] = True
-    eigenvalues, vectors = [], []
+    eigenvalues, fractions, groups = [], [], []
     for fields in coupled_field_groups((K, M), disc.field_of_dof):  # (62) one coupled group at a time
         dofs = np.flatnonzero(np.isin(disc.field_of_dof, fields)).astype(np.int32)
         free = int(np.count_nonzero(~constrained[dofs]))
         if free == 0:
             continue
         estimate = sum(estimates.get(f, 0.0) for f in fields)
-        values, group_vectors = _modes_of_block(K, M, dofs, free, max(8, int(safety * estimate) + 4), target,
-                                                f_max)
+        values, block = _modes_of_block(K, M, dofs, free, max(8, int(safety * estimate) + 4), target, f_max)
+        within = np.sqrt(np.clip(values, 0.0, None)) / (2.0 * math.pi) * p.length / c_L <= f_star_max
+        values, block = values[within], block[:, within]
+        # M-normalise (SLEPc does for GHEP; doing it again makes the contract explicit); M couples no two groups
+        group_mass = mass[dofs][:, dofs]
+        block /= np.sqrt(np.einsum("ij,ij->j", block, group_mass @ block))
         eigenvalues.append(values)
-        vectors.append(np.zeros((disc.ndofs, len(values))))
-        vectors[-1][dofs] = group_vectors
-    eigenvalues, vectors = np.concatenate(eigenvalues), np.hstack(vectors)
-    order = np.argsort(eigenvalues)
-    eigenvalues, vectors = eigenvalues[order], vectors[:, order]
-    # M-normalise (SLEPc does for GHEP; doing it again makes the contract explicit).
-    vectors /= np.sqrt(np.einsum("ij,ij->j", vectors, mass @ vectors))
-    freqs = np.sqrt(np.clip(eigenvalues, 0.0, None)) / (2.0 * math.pi)
-    f_star = freqs * p.length / c_L
-    keep = f_star <= f_star_max
-    fractions = field_mass_fractions(mass, disc.field_of_dof, vectors[:, keep])
-    kinds = [classify(fs, fr) for fs, fr in zip(f_star[keep], fractions)]
+        fractions.append(field_mass_fractions(group_mass, disc.field_of_dof[dofs], block))
+        groups.append((dofs, block if vectors else None))
     for obj in (K, M):
         obj.destroy()
-    return ModalBasis(freqs[keep], f_star[keep], kinds, fractions, vectors[:, keep])
+    order = np.argsort(np.concatenate(eigenvalues))
+    eigenvalues = np.concatenate(eigenvalues)[order]
+    fractions = np.concatenate(fractions)[order]
+    freqs = np.sqrt(np.clip(eigenvalues, 0.0, None)) / (2.0 * math.pi)
+    f_star = freqs * p.length / c_L
+    kinds = [classify(fs, fr) for fs, fr in zip(f_star, fractions)]
+    stacked = None
+    if vectors:
+        stacked = np.zeros((disc.ndofs, len(order)))
+        column = 0
+        for dofs, block in groups:
+            stacked[dofs[:, None], np.arange(column, column + block.shape[1])] = block
+            column += block.shape[1]
+        stacked = stacked[:, order]
+    return ModalBasis(freqs, f_star, kinds, fractions, stacked)
 
 
 def paper_bands(length: float, longitudinal_wave_speed: float) -> dict[str, float]:
@@ -350,7 +360,7 @@ def drive_held_modes(disc: BeamDiscretization, free: ModalBasis, f_star_max: flo
                           np.concatenate([part.f_star for part in parts]),
                           [kind for part in parts for kind in part.kinds],
                           np.concatenate([part.energy_fractions for part in parts]),
-                          np.hstack([part.vectors for part in parts]))
+                          None if free.vectors is None else np.hstack([part.vectors for part in parts]))
     return combined.select(np.argsort(combined.frequencies_hz, kind="stable"))
 
 

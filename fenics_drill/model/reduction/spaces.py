@@ -310,15 +310,17 @@ def solution_space(scene, disc: BeamDiscretization, operators: LinearOperators):
     """(space, kept modes, all modes, guard report, stuck-bit modes): the modal basis of the scene's
     reduction rule (Section 6.3), with the 'auto' rule's torsional modes of a stuck bit (None otherwise),
     checked and enriched by the guard (:mod:`fenics_drill.model.reduction.enrichment`), or the full space for
-    'none'; all modes of the band B (for spectra) either way."""
-    modes = solve_modes(disc, scene.modal.f_star_max, operators.mass)
+    'none'; all modes of the band B (for spectra) either way, without their vectors for the full space."""
     if scene.reduction.rule == "none":
-        return FullSpace(disc), None, modes, {}, None
+        return FullSpace(disc), None, solve_modes(disc, scene.modal.f_star_max, operators.mass, vectors=False), {}, \
+            None
     if (why := climbing_friction(scene, disc, operators)) is not None:
         if scene.reduction.rule == "auto":
-            return FullSpace(disc), None, modes, {"full_order": {"chosen": True, "why": why}}, None
+            return (FullSpace(disc), None, solve_modes(disc, scene.modal.f_star_max, operators.mass, vectors=False),
+                    {"full_order": {"chosen": True, "why": why}}, None)
         raise BasisError(f"reduction.rule = '{scene.reduction.rule}' is not admissible here: {why}; use "
                          "reduction.rule = 'auto' or 'none' (the full order), or contact.friction_model = 'paper'")
+    modes = solve_modes(disc, scene.modal.f_star_max, operators.mass)
     basis = modes.select(select_modes(modes, scene))
     vectors, stuck = basis.vectors, None
     if scene.reduction.rule == "auto" and scene.model.bit_rock:
