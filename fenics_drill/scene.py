@@ -120,8 +120,8 @@ class Contact:
                           "'model'", choices=("model", "consistent", "printed"))
     sliding_velocity_scale: float = _pos("slip speed v_s of the regularised signs tanh(x / v_s) of the paper's "
                                          "friction laws (18)-(19) [m/s]", 1e-5)
-    stick_stiffness: float = _pos("k_t of the Coulomb force's stuck contact (return mapping): the wall's "
-                                  "tangential spring below mu |F_n| [N/m]", 1e8)
+    stick_stiffness: float = _pos("k_t, the tangential spring of a stuck contact (the Coulomb force below mu |F_n|) "
+                                  "[N/m]", 1e8)
     culling: bool = key(True, "evaluate the wall law only where a vertex can reach the wall (exact)")
 
 @dataclass(frozen=True)
