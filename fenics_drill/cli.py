@@ -110,7 +110,7 @@ def cmd_run(args) -> int:
         f"{summary['status']}: {summary['message']}; t = {summary['t_end']:.4g} s in {summary['steps']} steps, "
         f"wall {summary['wall_time_s']:.1f} s -> {Path(args.out) / 'summary.json'}"
     )
-    if "mean_bit_velocity" in summary:
+    if "mean_bit_velocity" in summary and "rop" in summary:
         print(
             f"mean bit velocity {summary['mean_bit_velocity'] * 3600:.2f} m/h, rop {summary['rop'] * 3600:.2f} m/h, "
             f"impacts {summary['impacts_total']}, energy balance error {summary['energy']['balance_error']:.2e}"
