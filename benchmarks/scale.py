@@ -3,14 +3,15 @@ peak memory, on the paper's cross-section with the default model; rop and effici
 order; and a realistic well.
 
     python benchmarks/scale.py [--lengths 100 300 1000 3000 6000] [--t-end 1] [--converged-up-to 1000]
-                               [--well demos/scenes/well_vbh.toml] [--table benchmarks/results/scale.md]
+                               [--well demos/scenes/well_vbh.toml --well-elements 2000]
+                               [--table benchmarks/results/scale.md]
 
 Each length L runs `fenics-drill run demos/scenes/paper.toml --set beam.length=L --set beam.elements=2L --set
 time.t_end=T --set output.field_interval=0` in its own process (its peak resident memory is that process's, read
 from the kernel's accounting when it ends); the ratios are to the first length's row of the same invocation.  Up to
 ``--converged-up-to`` the same run at a tenth of time.error_tolerance (the step converged: the full order's own
 reference) gives the rop and efficiency the row is compared with.  ``--well`` adds one row for a well scene at its
-own length.
+own length, on ``--well-elements`` elements.
 """
 
 from __future__ import annotations
@@ -58,12 +59,13 @@ def main() -> None:
     parser.add_argument("--t-end", type=float, default=1.0)
     parser.add_argument("--converged-up-to", type=float, default=1000.0)
     parser.add_argument("--well", type=Path, default=None)
+    parser.add_argument("--well-elements", type=int, default=2000)
     parser.add_argument("--table", type=Path, default=ROOT / "benchmarks" / "results" / "scale.md")
     args = parser.parse_args()
     lines = ["# The cost of a run against the string's length", "",
              f"Command: `python benchmarks/scale.py --lengths {' '.join(f'{x:g}' for x in args.lengths)} --t-end "
              f"{args.t_end:g} --converged-up-to {args.converged_up_to:g}"
-             f"{f' --well {args.well}' if args.well else ''}`. Machine: {platform.machine()}, {os.cpu_count()} cores, "
+             f"{f' --well {args.well} --well-elements {args.well_elements}' if args.well else ''}`. Machine: {platform.machine()}, {os.cpu_count()} cores, "
              f"Python {platform.python_version()}, {time.strftime('%Y-%m-%d')}; one run at a time. The paper's "
              "cross-section, 2 elements per metre, the default model and friction; the converged reference is the "
              "same run at time.error_tolerance = 1e-6 (a tenth of the default).", "",
@@ -74,7 +76,8 @@ def main() -> None:
     first = None
     rows = [(length, None) for length in args.lengths] + ([(None, args.well)] if args.well else [])
     for length, well in rows:
-        row = measure(length, args.t_end) if well is None else measure(None, args.t_end, well)
+        row = measure(length, args.t_end) if well is None else \
+            measure(None, args.t_end, well, (f"beam.elements={args.well_elements}",))
         first = first or row
         rop = f"{row['rop'] * 3600:.3f}" if row["rop"] is not None else "-"
         efficiency = f"{row['efficiency']:.4f}" if row["efficiency"] is not None else "-"
