@@ -68,10 +68,11 @@ def polled_barrier(comm, out: Path | None = None) -> None:
             raise stop
 
 
-def claim(out: Path, scene: dict, command: str, resume: bool, overwrite: bool, comm) -> OutputClaim:
+def claim(out: Path, scene: dict, command: str, resume: bool, overwrite: bool, comm, counts=None) -> OutputClaim:
     """On rank 0: take ``out`` for ``command``, refuse another scene's study, record the scene, clear the rank
     markers of an earlier run.  Every rank raises the same OutputError on refusal; each returns its claim
-    (rank 0's holds the directory's lock, the others' nothing), to hold to the end of the study."""
+    (rank 0's holds the directory's lock, the others' nothing), to hold to the end of the study.  A study stopped
+    while the ranks meet here has its summary say so, with what ``counts()`` says is asked and done."""
     error, held = None, OutputClaim(out, command, None)
     if comm.rank == 0:
         try:
@@ -91,7 +92,8 @@ def claim(out: Path, scene: dict, command: str, resume: bool, overwrite: bool, c
     except KeyboardInterrupt:  # stopped before the study began: what rank 0 took says so
         if comm.rank == 0 and error is None:
             write_json(out / "summary.json", {"command": command, "status": "interrupted",
-                                              "message": "stopped by Ctrl-C or SIGTERM before the study began"})
+                                              "message": "stopped by Ctrl-C or SIGTERM before the study began",
+                                              **(counts() if counts is not None else {})})
         raise
     if error:
         raise OutputError(error)

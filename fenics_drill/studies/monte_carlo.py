@@ -56,7 +56,7 @@ def monte_carlo(scene, samples: int, out: str | Path, resume: bool = False, prog
     def counts() -> dict:
         return {"samples": samples, "realisations_done": len(list((out / "realisations").glob("*.h5")))}
 
-    with claim(out, scene.to_dict(), "mc", resume, overwrite, comm), study_run(out, "mc", comm, counts):
+    with claim(out, scene.to_dict(), "mc", resume, overwrite, comm, counts), study_run(out, "mc", comm, counts):
         if comm.rank == 0:
             (out / "realisations").mkdir(exist_ok=True)
         polled_barrier(comm)

@@ -169,7 +169,8 @@ def run_optimize(scene, out: str | Path, resume: bool = False, progress: bool = 
     def counts() -> dict:
         return {"runs": total, "runs_done": len(list((out / "points").glob("*.json")))}
 
-    with claim(out, scene.to_dict(), "optimize", resume, overwrite, comm), study_run(out, "optimize", comm, counts):
+    with claim(out, scene.to_dict(), "optimize", resume, overwrite, comm, counts), \
+            study_run(out, "optimize", comm, counts):
         if comm.rank == 0:
             (out / "points").mkdir(exist_ok=True)
         polled_barrier(comm)
