@@ -82,7 +82,8 @@ def resting_guess(model: DrillstringModel) -> np.ndarray | None:
     at rest (:func:`~fenics_drill.model.soft_string.soft_string`, no friction) says the wall carries it, on the
     side its wall force comes from, RESTING_PENETRATION of the clearance into the wall (its springs act from the
     first iterate); stretched by that model's tension.  From the straight string a long well's first updates sag
-    it by kilometres and the move limit lets it creep.  None for the straight horizontal hole or a modal space."""
+    it by kilometres and the move limit lets it creep.  Between the pressed lengths it runs straight from one to the
+    next.  None for the straight horizontal hole or a modal space."""
     disc, scene = model.disc, model.scene
     if disc.trajectory is None or not model.space.sparse:
         return None
@@ -101,7 +102,11 @@ def resting_guess(model: DrillstringModel) -> np.ndarray | None:
         pressed = rest["wall_force_per_length"][k] > RESTING_SHARE * mesh.weight[k]
         toward = -np.einsum("ij,ij->i", rest["wall_force_direction"][k], getattr(disc.trajectory.bishop_frames(x), axis))
         gap = (1.0 + RESTING_PENETRATION) * np.interp(x, disc.vertex_x, model.vertex_gap)
-        dofs[at] = np.where(pressed, gap * toward, 0.0)
+        # between the pressed lengths (and from the top, held on the axis) the string runs straight from one to the
+        # next: a step from the axis onto the wall within one element would be a shear strain of gap / element
+        order = np.argsort(x)
+        on_wall = order[pressed[order]]
+        dofs[at] = np.interp(x, np.concatenate([[0.0], x[on_wall]]), np.concatenate([[0.0], (gap * toward)[on_wall]]))
     at = disc.field_dofs[U]
     x = disc.dof_coordinates[at]
     p = disc.element_properties
