@@ -77,6 +77,7 @@ def test_the_force_never_exceeds_mu_fn_opposes_the_slip_and_its_tangent_is_its_d
     assert np.array_equal(np.column_stack([axial, tangential])[stuck], trial[stuck])
     along = (axial * trial[:, 1] - tangential * trial[:, 0])[~stuck]  # parallel to the trial where it slips
     assert np.all(np.abs(along) <= 1e-12 * (magnitude * np.hypot(*trial.T))[~stuck])
+    # scaled back onto the cone: mu |F_n| F* / |F*| has the magnitude mu |F_n| to a few ulps of the hypot and division
     assert magnitude[~stuck] == pytest.approx(MU * np.abs(normal[~stuck]), rel=1e-12)
     fresh_a, fresh_t = coulomb_friction(normal, 0 * normal, 0 * normal, slips[:, 0], slips[:, 1], MU, k_t)
     assert np.all(fresh_a * slips[:, 0] + fresh_t * slips[:, 1] <= 0.0)
