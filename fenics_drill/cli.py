@@ -104,8 +104,12 @@ def cmd_run(args) -> int:
     """Drilling dynamics from the static equilibrium: summary.json, timeseries.h5, fields.xdmf."""
     from fenics_drill.studies.run import run_scene
 
+    from mpi4py import MPI
+
     scene = load_scene(args.scene, args.overrides)
     summary = run_scene(scene, args.out, progress=not args.quiet, overwrite=args.overwrite)
+    if MPI.COMM_WORLD.rank > 0:  # the second rank of a shared run: the first reports
+        return {"finished": 0, "interrupted": 130}.get(summary["status"], 1)
     print(
         f"{summary['status']}: {summary['message']}; t = {summary['t_end']:.4g} s in {summary['steps']} steps, "
         f"wall {summary['wall_time_s']:.1f} s -> {Path(args.out) / 'summary.json'}"
@@ -295,19 +299,21 @@ def _user_errors() -> tuple[type, ...]:
     from fenics_drill.plots.directory import NothingToPlot
     from fenics_drill.model.rotating_modes import Divergence, TooFewModes
     from fenics_drill.studies.campbell import CampbellError
+    from fenics_drill.studies.shared_run import RankCountError
     from fenics_drill.studies.uncertainty import InadmissibleLaw
 
     return (SceneError, OutputError, ResourceError, UnreadableFile, InadmissibleLaw, NothingToPlot, BasisError,
-            CampbellError, Divergence, TooFewModes)
+            CampbellError, Divergence, TooFewModes, RankCountError)
 
 
 def _collective_errors() -> tuple[type, ...]:
     """Errors every MPI rank meets alike (scene checks, laws, the study directory's verdict broadcast by
     rank 0): each rank can return its code.  Any other error on one rank ends the job with MPI_Abort."""
     from fenics_drill.io.output_directory import OutputError
+    from fenics_drill.studies.shared_run import RankCountError
     from fenics_drill.studies.uncertainty import InadmissibleLaw
 
-    return SceneError, OutputError, InadmissibleLaw
+    return SceneError, OutputError, InadmissibleLaw, RankCountError
 
 
 def _execute(args) -> int:
@@ -391,11 +397,17 @@ def _quiet_excepthook(kind, value, trace, default=sys.excepthook) -> None:
         default(kind, value, trace)
 
 
+def _under_mpiexec() -> bool:
+    """Started by an MPI process manager (MPICH's hydra, Open MPI, PMIx): the manager delivers the signals to
+    every rank, and a worker process of the supervisor could not join the job's MPI world."""
+    return any(name in os.environ for name in ("PMI_RANK", "PMI_SIZE", "PMIX_RANK", "OMPI_COMM_WORLD_SIZE"))
+
+
 def _main(argv: list[str] | None) -> int:
     sys.unraisablehook, sys.excepthook = _quiet_about_full_disks, _quiet_excepthook
     parser = build_parser()
     args = parser.parse_args(argv)
-    if argv is None and args.command in SUPERVISED:
+    if argv is None and args.command in SUPERVISED and not _under_mpiexec():
         from fenics_drill import supervisor
 
         if not supervisor.is_worker():

@@ -28,7 +28,9 @@ import scipy.sparse as sp
 from fenics_drill.model.discretization import THETA_X, U, V, W, BeamDiscretization
 from fenics_drill.model.forces import ForceEvaluation, build_forces
 from fenics_drill.model.reduction.hyper_reduction import RETRAIN_ABOVE, sampling_error, train_sample
-from fenics_drill.model.internal_force import ElementSample, internal_force
+from fenics_drill.model.internal_force import (AssembledInternalForce, ElementSample, SplitInternalForce,
+                                              internal_force)
+from fenics_drill.model.kernels.split_band import StringSplit
 from fenics_drill.model.resolution import band_frequency
 from fenics_drill.model.operators import LinearOperators, assemble_linear
 from fenics_drill.model.reduction.out_of_band_damping import OutOfBandDamping
@@ -198,6 +200,23 @@ class DrillstringModel:
         """The same string in the full finite-element space (no modal reduction), sharing the operators."""
         return DrillstringModel(self.scene, self.disc, FullSpace(self.disc),
                                 self.operators, None, self.modes, {})
+
+    def split_over(self, comm) -> "DrillstringModel":
+        """This full-order model with its elements shared between the two ranks of ``comm``: each assembles its own
+        half's internal force and tangent, and the saddle system (76) is solved across both
+        (:mod:`~fenics_drill.model.kernels.split_band`).  Every rank steps the whole state alike."""
+        if not self.space.sparse or not isinstance(self.internal, AssembledInternalForce):
+            raise ValueError("a run splits its string over MPI ranks in the full order with its nonlinear internal "
+                             "force only (reduction.rule = 'none', or 'auto' where it chooses the full order; "
+                             "model.geometric_nonlinearity or model.inertial_nonlinearity on)")
+        split = StringSplit(self.disc, self.space, comm)
+        model = copy.copy(self)
+        model.space = self.space.split(split)
+        share = AssembledInternalForce(self.disc, model.space, self.operators, *self.internal.switches,
+                                       cells=split.cells)
+        model.internal = SplitInternalForce(self.internal, share, comm)
+        model._kept_internal_tangent = None
+        return model
 
     def with_vectors(self, vectors: np.ndarray, guard: dict) -> "DrillstringModel":
         """A model whose modal basis also spans the full-space ``vectors`` (M-orthonormalised), with the

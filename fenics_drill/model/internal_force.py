@@ -27,6 +27,7 @@ from dolfinx import fem
 from petsc4py import PETSc
 
 from fenics_drill.forms import energies
+from fenics_drill.model.kernels.banded_saddle import SparseSum
 from fenics_drill.model.kernels.cell_kernels import CellAssembly
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.operators import LinearOperators
@@ -89,7 +90,8 @@ class InternalForms:
     full order; each element sample and the trainer of a sample) share them and their functions U, V, A.
     A sample is a choice of cells and their weights (:class:`SampledCoefficients`), not a form."""
 
-    def __init__(self, disc: BeamDiscretization, switches: tuple, sampled: bool):
+    def __init__(self, disc: BeamDiscretization, switches: tuple, sampled: bool, cells: np.ndarray | None = None):
+        """``cells``: the forms integrate over these elements only (a rank's share of a split string); None: all."""
         geometric_nonlinearity, inertial_nonlinearity, kinematics, angular_velocity = switches
         p = disc.form_properties
         # Energies are polynomials of degree <= 4 in the fields up to sin/cos(theta_x):
@@ -97,7 +99,8 @@ class InternalForms:
         metadata = {"quadrature_degree": 2 * disc.element_degree}
         self.functions = U, V, A = tuple(fem.Function(disc.V) for _ in range(3))
         psi, dU = ufl.TestFunction(disc.V), ufl.TrialFunction(disc.V)
-        dx = ufl.Measure("dx", domain=disc.mesh, metadata=metadata)
+        dx = ufl.Measure("dx", domain=disc.mesh, metadata=metadata) if cells is None else ufl.Measure(
+            "dx", domain=disc.mesh, metadata=metadata, subdomain_data=[(1, cells)], subdomain_id=1)
         weight = self.weight = fem.Function(fem.functionspace(disc.mesh, ("DG", 0))) if sampled else 1.0
 
         def inertial(nonlinear):
@@ -130,12 +133,15 @@ class InternalForms:
                                for field in (U, V, A))
 
     @classmethod
-    def of(cls, disc: BeamDiscretization, switches: tuple, sampled: bool) -> "InternalForms":
-        """The forms of a string, whole or ``sampled``: built on first use, then shared."""
+    def of(cls, disc: BeamDiscretization, switches: tuple, sampled: bool,
+           cells: np.ndarray | None = None) -> "InternalForms":
+        """The forms of a string, whole or ``sampled``, over all its elements or ``cells``: built on first use, then
+        shared."""
         built = _FORMS.setdefault(disc, {})
-        if (switches, sampled) not in built:
-            built[switches, sampled] = cls(disc, switches, sampled)
-        return built[switches, sampled]
+        key = (switches, sampled, None if cells is None else cells.tobytes())
+        if key not in built:
+            built[key] = cls(disc, switches, sampled, cells)
+        return built[key]
 
 
 #: The forms of each string (discretization) alive, by their switches and whether they are sampled.
@@ -157,11 +163,13 @@ class AssembledInternalForce:
 
     def __init__(self, disc: BeamDiscretization, space, operators: LinearOperators,
                  geometric_nonlinearity: bool, inertial_nonlinearity: bool, kinematics: str = "objective",
-                 angular_velocity: str = "consistent", sample: ElementSample | None = None):
+                 angular_velocity: str = "consistent", sample: ElementSample | None = None,
+                 cells: np.ndarray | None = None):
+        """``cells``: the force of these elements only (a rank's share of a split string, full order); None: all."""
         self.space, self.sample = space, sample
         self._field_of_dof = disc.field_of_dof
         self.switches = (geometric_nonlinearity, inertial_nonlinearity, kinematics, angular_velocity)
-        forms = InternalForms.of(disc, self.switches, sample is not None)
+        forms = InternalForms.of(disc, self.switches, sample is not None, cells)
         self.U, self.V, self.A = forms.functions
         self._kinetic, self._strain, self._residual, self._jacobians = (forms.kinetic, forms.strain, forms.residual,
                                                                        forms.jacobians)
@@ -309,6 +317,42 @@ class AssembledInternalForce:
 
     def damping_force(self, qd) -> np.ndarray:
         return self._damping @ qd
+
+
+class SplitInternalForce:
+    """The internal force of a full-order string split over two MPI ranks
+    (:mod:`~fenics_drill.model.kernels.split_band`): assembled over this rank's elements (``share``) and summed over
+    the ranks, so every rank holds the whole force; its tangent parts are this rank's own
+    (:class:`~fenics_drill.model.kernels.banded_saddle.SparseSum` ``own``).  The energies and the damping force,
+    which the energy budget and the outputs read at accepted steps only, are the ``whole`` string's."""
+
+    state_dependent = True
+
+    def __init__(self, whole: AssembledInternalForce, share: AssembledInternalForce, comm):
+        self.whole, self.share, self.comm = whole, share, comm
+        self.switches = whole.switches
+
+    def evaluate(self, q, qd, qdd) -> np.ndarray:
+        part = np.ascontiguousarray(self.share.evaluate(q, qd, qdd))
+        out = np.empty_like(part)
+        self.comm.Allreduce(part, out)
+        return out
+
+    def tangent_parts(self, needed=(True, True, True)):
+        return tuple(None if part is None else SparseSum([(1.0, part)], part.shape, own=True)
+                     for part in self.share.tangent_parts(needed))
+
+    def kinetic_energy(self, q, qd) -> float:
+        return self.whole.kinetic_energy(q, qd)
+
+    def strain_energy(self, q) -> float:
+        return self.whole.strain_energy(q)
+
+    def energies(self, qs: np.ndarray, qds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return self.whole.energies(qs, qds)
+
+    def damping_force(self, qd) -> np.ndarray:
+        return self.whole.damping_force(qd)
 
 
 class SampledCoefficients:

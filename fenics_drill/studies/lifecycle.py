@@ -97,6 +97,29 @@ def uninterrupted(stop_after: bool = True):
 
 
 @contextmanager
+def uninterrupted_together(comm):
+    """:func:`uninterrupted` for the ranks that take the steps of one run together
+    (:mod:`~fenics_drill.studies.shared_run`): at the end of the block the ranks tell each other whether a signal
+    arrived, and if one did on any of them, every rank raises KeyboardInterrupt after the same step (a rank that
+    stopped alone would leave the others waiting in the step's collectives)."""
+    from mpi4py import MPI
+
+    stop = StopOnSignal.active
+    if stop is None:
+        yield
+        return
+    stop.deferring += 1
+    try:
+        yield
+    finally:
+        stop.deferring -= 1
+    if comm.allreduce(stop.requested, op=MPI.LOR):
+        stop.requested = True
+        if not stop.deferring:
+            raise KeyboardInterrupt
+
+
+@contextmanager
 def command_output(out: str | Path, command: str, scene, overwrite: bool = False):
     """Check that the scene fits in memory (ResourceError), take ``out`` for ``command`` (OutputError),
     both before any computation, and yield the summary dict the command fills; on the way out

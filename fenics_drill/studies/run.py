@@ -8,6 +8,7 @@ ends (finished, failed with the reason, or interrupted with Ctrl-C) and says whi
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import socket
@@ -17,6 +18,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from mpi4py import MPI
 
 from fenics_drill.io.fields import FieldWriter
 from fenics_drill.io.files import no_room_message, write_atomic, write_final_json, write_json
@@ -35,8 +37,9 @@ from fenics_drill.solvers.static import StaticFailure, static_report
 from fenics_drill.model.resolution import band_frequency, mesh_advice
 from fenics_drill.solvers.step_control import StepTooSmall, nominal_step, steps_per_band_period
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
-from fenics_drill.studies.lifecycle import StopOnSignal, command_output, uninterrupted
+from fenics_drill.studies.lifecycle import StopOnSignal, command_output, uninterrupted, uninterrupted_together
 from fenics_drill.studies.prepare import prepare
+from fenics_drill.studies.shared_run import check_ranks, check_same_state, second_rank_run, shared_model
 from fenics_drill.studies.torque_drag import fe_static_profiles, write_path_vtu
 
 
@@ -218,18 +221,33 @@ class RunRecorder:
             self.fields.close()
 
 
-def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = False) -> dict:
+def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = False, comm=None) -> dict:
     """Static equilibrium, then the drilling dynamics to time.t_end; returns the summary.
 
     The output directory is taken under the policy of :mod:`fenics_drill.io.output_directory`
     (OutputError before any computation).  While the run runs, ``summary.json`` says "running"
     and how far it got at the last write of the files; at the end it holds the whole summary,
     however the run ended: finished, suspect (finished, but physically doubtful: see
-    ``suspect_reasons``), failed (with when and why) or interrupted (Ctrl-C, SIGTERM)."""
+    ``suspect_reasons``), failed (with when and why) or interrupted (Ctrl-C, SIGTERM).
+
+    On the two ranks of ``comm`` (default: MPI's world; ``mpiexec -n 2``) a full-order string is split between
+    them and the first writes the files (:mod:`fenics_drill.studies.shared_run`); the second returns what it
+    did, without files."""
     out = Path(out)
-    check_memory(scene.beam.elements, scene.beam.element_degree)
-    _check_disk_for_run(scene, out)
-    claim = claim_output(out, "run", overwrite)
+    comm = MPI.COMM_WORLD if comm is None else comm
+    check_ranks(comm)
+    if comm.rank > 0:  # the second rank of a run shared by two (studies/shared_run.py): it writes nothing
+        return second_rank_run(scene, comm, comm.bcast(None, root=0))
+    try:
+        check_memory(scene.beam.elements, scene.beam.element_degree)
+        _check_disk_for_run(scene, out)
+        claim = claim_output(out, "run", overwrite)
+    except Exception as err:
+        if comm.size > 1:
+            comm.bcast(str(err), root=0)
+        raise
+    if comm.size > 1:
+        comm.bcast(None, root=0)
     clock = time.perf_counter()
     summary: dict = {"command": "run", "status": "failed", "message": "", "t_end": 0.0, "steps": 0}
     recorder = simulation = None
@@ -254,14 +272,21 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
             summary["basis_guard"] = model.guard
             summary["discretisation"] = _discretisation(model, scene)
             summary["setup_time_s"], summary["static"] = prepared.setup_time_s, prepared.static
+            atomic = uninterrupted
+            if comm.size > 1:
+                model, summary["ranks"] = shared_model(model, comm)
+                if summary["ranks"]["split"]:
+                    atomic = functools.partial(uninterrupted_together, comm)
             simulation = Simulation(model, scene)
             start = simulation.initial_state(equilibrium.q)
+            if atomic is not uninterrupted:
+                check_same_state(comm, start.q)
             recorder = RunRecorder(model, scene, out, on_write=running)
             u0 = model.bit_state(start.q, start.qd)[0]
             summary["nominal_dt"] = nominal_step(scene)
             loop_clock = time.perf_counter()
             try:
-                final = simulation.run(start, scene.time.t_end, recorder, Progress(progress), atomic=uninterrupted)
+                final = simulation.run(start, scene.time.t_end, recorder, Progress(progress), atomic=atomic)
                 summary["status"], summary["message"] = "finished", "reached time.t_end"
             except StepTooSmall as failure:
                 final = None

@@ -3,7 +3,7 @@
 A beam on an interval mesh couples each dof only with those of its own elements, so once the dofs are
 numbered along the string (by their x) the tangent J is a band about as wide as one element's dofs.
 In the full space every row of [B] holds one dof (u(0) or theta_x(0)), so the constraints are
-eliminated exactly instead of bordering the matrix:
+eliminated exactly instead of bordering the matrix (taken out of the band into dense columns and rows):
 
     x_c = g / b,   A x = r - J[:, c] x_c  with row and column c of J replaced by the identity,
     mu = (r_c - (J x)_c) / b
@@ -35,34 +35,38 @@ def held_dofs(constraints) -> tuple[np.ndarray, np.ndarray]:
 
 
 @kernel
-def _band_widths(rows, columns, position, held_slot):
-    """(kl, ku): the lower and upper bandwidths of the renumbered matrix without the held rows and columns."""
+def _band_widths(rows, columns, position, taken_slot):
+    """(kl, ku): the lower and upper bandwidths of the renumbered matrix without the taken-out rows and columns."""
     kl, ku = 0, 0
     for k in range(rows.size):
-        if held_slot[rows[k]] < 0 and held_slot[columns[k]] < 0:
-            d = position[rows[k]] - position[columns[k]]
-            kl, ku = max(kl, d), max(ku, -d)
+        row, col = position[rows[k]], position[columns[k]]
+        if row >= 0 and col >= 0 and taken_slot[row] < 0 and taken_slot[col] < 0:
+            kl, ku = max(kl, row - col), max(ku, col - row)
     return kl, ku
 
 
 @kernel
-def _band_fill(rows, columns, data, position, held_slot, kl, ku, band, held_columns, held_rows):
-    """LAPACK's band storage of the renumbered matrix (the held dofs' rows and columns left out) and the matrix's
-    held columns and rows (dense), added in one pass over its (row, column, value) entries (repeated ones add up).
-    Returns the number of entries outside the bandwidths (kl, ku), which are left out."""
+def _band_fill(rows, columns, data, position, taken_slot, kl, ku, band, taken_columns, taken_rows):
+    """LAPACK's band storage of the renumbered matrix (the taken-out dofs' rows and columns left out) and the
+    matrix's taken-out columns and rows (dense, by band index), added in one pass over its (row, column, value)
+    entries (repeated ones add up).  ``position``: each dof's band index, -1 for a dof not in this band (another
+    rank's: :mod:`~fenics_drill.model.kernels.split_band`), whose entries are left out.  Returns the number of
+    entries outside the bandwidths (kl, ku), which are left out."""
     outside = 0
     for k in range(rows.size):
-        row, col, value = rows[k], columns[k], data[k]
-        if held_slot[col] >= 0:
-            held_columns[row, held_slot[col]] += value
-        if held_slot[row] >= 0:
-            held_rows[held_slot[row], col] += value
-        elif held_slot[col] < 0:
-            d = position[row] - position[col]
+        row, col, value = position[rows[k]], position[columns[k]], data[k]
+        if row < 0 or col < 0:
+            continue
+        if taken_slot[col] >= 0:
+            taken_columns[row, taken_slot[col]] += value
+        if taken_slot[row] >= 0:
+            taken_rows[taken_slot[row], col] += value
+        elif taken_slot[col] < 0:
+            d = row - col
             if d > kl or -d > ku:
                 outside += 1
             else:
-                band[kl + ku + d, position[col]] += value
+                band[kl + ku + d, col] += value
     return outside
 
 
@@ -70,13 +74,16 @@ class SparseSum:
     """sum of c A over the (c, A) of ``terms`` (sparse matrices, or sums themselves), kept as its terms: the banded
     solve lays each term into the band itself, and a term kept across many tangents (the internal tangent, kept
     over Newton iterations and steps) keeps its band, so that each new tangent copies it and adds the few entries
-    of the point forces (a tenth of the entries of the whole) instead of laying all of them out again."""
+    of the point forces (a tenth of the entries of the whole) instead of laying all of them out again.
 
-    def __init__(self, terms, shape: tuple[int, int]):
+    ``own``: in a string split over MPI ranks (:mod:`~fenics_drill.model.kernels.split_band`), the entries are this
+    rank's own (assembled over its elements); otherwise every rank holds all of them (the point forces)."""
+
+    def __init__(self, terms, shape: tuple[int, int], own: bool = False):
         self.terms = [(float(c), matrix if isinstance(matrix, (SparseSum, sp.coo_matrix)) else sp.coo_matrix(matrix))
                       for c, matrix in terms]
-        self.shape = shape
-        self._bands = {}  # (order, held dofs, widths) -> (band, held columns, held rows) of this sum
+        self.shape, self.own = shape, own
+        self._bands = {}  # layout key -> (band, taken-out columns, taken-out rows) of this sum
 
     def tocoo(self) -> sp.coo_matrix:
         """The sum as one COO matrix (repeated entries add up)."""
@@ -100,11 +107,12 @@ class SparseSum:
             out = term if out is None else out + term
         return np.zeros(self.shape[0]) if out is None else out
 
-    def laid_out(self, layout: "_BandLayout") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(band, held columns, held rows) of this sum in ``layout``, kept for the next tangent that holds it."""
+    def laid_out(self, layout: "BandLayout") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(band, taken-out columns, taken-out rows) of this sum in ``layout``, kept for the next tangent that
+        holds it."""
         if layout.key not in self._bands:
             arrays = layout.empty()
-            _add_terms(self.terms, layout, arrays)
+            _add_terms(self.terms, layout, arrays, self.own)
             layout.set_identity(arrays[0])
             if len(self._bands) > 2:  # a sum is laid out for one or two saddle systems (a run's and its statics')
                 self._bands.clear()
@@ -112,46 +120,70 @@ class SparseSum:
         return self._bands[layout.key]
 
 
-def _add_terms(terms, layout: "_BandLayout", arrays) -> None:
-    """Add sum c A of ``terms`` into (band, held columns, held rows): a sum of several terms from its kept layout,
-    any other term entry by entry."""
+def _add_terms(terms, layout: "BandLayout", arrays, own: bool) -> None:
+    """Add sum c A of ``terms`` into (band, taken-out columns, taken-out rows): a sum of several terms from its
+    kept layout, any other term entry by entry (``own``: the terms are this rank's own, :class:`SparseSum`)."""
     for c, matrix in terms:
         if isinstance(matrix, SparseSum) and len(matrix.terms) > 1:
             for mine, theirs in zip(arrays, matrix.laid_out(layout)):
                 mine += theirs if c == 1.0 else c * theirs
         elif isinstance(matrix, SparseSum):
-            _add_terms([(c * inner, leaf) for inner, leaf in matrix.terms], layout, arrays)
+            _add_terms([(c * inner, leaf) for inner, leaf in matrix.terms], layout, arrays, own or matrix.own)
         else:
-            layout.fill(matrix, c, *arrays)
+            layout.fill(matrix, c, own, *arrays)
 
 
-class _BandLayout:
-    """Where the entries of a tangent go in LAPACK's band storage: its dofs renumbered by ``order``, the held
-    ones taken out into dense columns and rows (module doc)."""
+class BandLayout:
+    """Where the entries of a tangent go in LAPACK's band storage: each dof's band index ``position`` (-1: not in
+    this band), and for the entries every rank holds ``shared_position`` (the same, or -1 where another rank adds
+    them); the dofs at the band indices ``taken`` are taken out into dense columns and rows, an identity left on
+    their diagonal (module doc)."""
 
-    def __init__(self, n: int, order: np.ndarray, held: np.ndarray, kl: int, ku: int):
-        self.n, self.kl, self.ku = n, kl, ku
-        self.held_slot = np.full(n, -1, dtype=np.int64)
-        self.held_slot[held] = np.arange(held.size)
-        self.position = np.empty(n, dtype=np.int64)
-        self.position[order] = np.arange(n)
-        self.key = (id(order), tuple(held.tolist()), kl, ku)
+    def __init__(self, position: np.ndarray, taken: np.ndarray, n: int, kl: int, ku: int, key,
+                 shared_position: np.ndarray | None = None):
+        self.n, self.kl, self.ku, self.taken = n, kl, ku, taken
+        self.position = position
+        self.shared_position = position if shared_position is None else shared_position
+        self.taken_slot = np.full(n, -1, dtype=np.int64)
+        self.taken_slot[taken] = np.arange(taken.size)
+        self.key = (key, tuple(taken.tolist()), kl, ku)
 
     def empty(self):
         return (np.zeros((self.n, 2 * self.kl + self.ku + 1)).T,  # Fortran order, as LAPACK stores it
-                np.zeros((self.n, self.held_slot.max() + 1)), np.zeros((self.held_slot.max() + 1, self.n)))
+                np.zeros((self.n, self.taken.size)), np.zeros((self.taken.size, self.n)))
 
-    def fill(self, matrix: sp.coo_matrix, c: float, band, held_columns, held_rows) -> None:
+    def fill(self, matrix: sp.coo_matrix, c: float, own: bool, band, taken_columns, taken_rows) -> None:
         data = matrix.data if c == 1.0 else c * matrix.data
-        outside = _band_fill(matrix.row, matrix.col, data, self.position, self.held_slot, self.kl, self.ku, band,
-                             held_columns, held_rows)
+        outside = _band_fill(matrix.row, matrix.col, data, self.position if own else self.shared_position,
+                             self.taken_slot, self.kl, self.ku, band, taken_columns, taken_rows)
         if outside:
             raise ValueError(f"{outside} entries of the tangent lie outside its bandwidth {self.kl}: a force couples "
                              "dofs of different elements")
 
     def set_identity(self, band) -> None:
-        held = np.flatnonzero(self.held_slot >= 0)
-        band[self.kl + self.ku, self.position[held]] = 1.0
+        band[self.kl + self.ku, self.taken] = 1.0
+
+    def laid_out(self, tangent) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(band, taken-out columns, taken-out rows) of ``tangent`` (a sparse matrix or a :class:`SparseSum`)."""
+        terms = tangent.terms if isinstance(tangent, SparseSum) else [(1.0, sp.coo_matrix(tangent))]
+        own = isinstance(tangent, SparseSum) and tangent.own
+        first = terms[0][1] if terms else None
+        if terms[:1] and terms[0][0] == 1.0 and isinstance(first, SparseSum) and len(first.terms) > 1:
+            # a sum led by a kept one (the internal tangent): a copy of its layout, the fresh terms (the point
+            # forces) added
+            arrays, terms = tuple(a.copy(order="K") for a in first.laid_out(self)), terms[1:]
+        else:
+            arrays = self.empty()
+        _add_terms(terms, self, arrays, own)
+        self.set_identity(arrays[0])
+        return arrays
+
+
+def band_order_positions(order: np.ndarray) -> np.ndarray:
+    """Each dof's index in the numbering ``order`` (index -> dof)."""
+    position = np.empty(order.size, dtype=np.int64)
+    position[order] = np.arange(order.size)
+    return position
 
 
 class BandedSaddle:
@@ -163,24 +195,16 @@ class BandedSaddle:
         n = tangent.shape[0]
         self.held, self.coefficients = held_dofs(constraints)
         self.order = order
+        position = band_order_positions(order)
+        self.held_band = position[self.held]
         if width is None:
             coo = tangent.tocoo() if isinstance(tangent, SparseSum) else sp.coo_matrix(tangent)
-            probe = _BandLayout(n, order, self.held, 0, 0)
-            self.kl, self.ku = _band_widths(coo.row, coo.col, probe.position, probe.held_slot)
+            probe = BandLayout(position, self.held_band, n, 0, 0, id(order))
+            self.kl, self.ku = _band_widths(coo.row, coo.col, position, probe.taken_slot)
         else:
             self.kl = self.ku = width
-        layout = _BandLayout(n, order, self.held, self.kl, self.ku)
-        terms = tangent.terms if isinstance(tangent, SparseSum) else [(1.0, sp.coo_matrix(tangent))]
-        first = terms[0][1] if terms else None
-        if terms[:1] and terms[0][0] == 1.0 and isinstance(first, SparseSum) and len(first.terms) > 1:
-            # a sum led by a kept one (the internal tangent): a copy of its layout, the fresh terms (the point
-            # forces) added
-            arrays, terms = tuple(a.copy(order="K") for a in first.laid_out(layout)), terms[1:]
-        else:
-            arrays = layout.empty()
-        _add_terms(terms, layout, arrays)
-        band, self.held_columns, self.held_rows = arrays
-        layout.set_identity(band)
+        layout = BandLayout(position, self.held_band, n, self.kl, self.ku, id(order))
+        band, self.held_columns, self.held_rows = layout.laid_out(tangent)
         self.lu, self.pivots, info = lapack.dgbtrf(band, self.kl, self.ku, overwrite_ab=1)
         if info != 0:
             raise np.linalg.LinAlgError(f"the saddle matrix (76) is singular (LAPACK dgbtrf info = {info})")
@@ -188,12 +212,12 @@ class BandedSaddle:
     def __call__(self, rhs_q: np.ndarray, rhs_c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(dq, mu) of [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c)."""
         x_held = np.asarray(rhs_c, dtype=float) / self.coefficients
-        rhs = rhs_q - self.held_columns @ x_held
-        rhs[self.held] = x_held
-        permuted, info = lapack.dgbtrs(self.lu, self.kl, self.ku, rhs[self.order], self.pivots, overwrite_b=1)
+        rhs = rhs_q[self.order] - self.held_columns @ x_held
+        rhs[self.held_band] = x_held
+        permuted, info = lapack.dgbtrs(self.lu, self.kl, self.ku, rhs, self.pivots, overwrite_b=1)
         if info != 0:
             raise np.linalg.LinAlgError(f"LAPACK dgbtrs info = {info}")
         x = np.empty_like(permuted)
         x[self.order] = permuted
-        mu = (rhs_q[self.held] - self.held_rows @ x) / self.coefficients
+        mu = (rhs_q[self.held] - self.held_rows @ permuted) / self.coefficients
         return x, mu

@@ -14,6 +14,8 @@ u(0, t) = V0 t and theta_x(0, t) = Omega t need Lagrange multipliers (70)-(76).
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
@@ -22,6 +24,7 @@ from scipy.linalg.lapack import dgetrf as getrf
 from scipy.linalg.lapack import dgetrs as getrs
 
 from fenics_drill.model.kernels.banded_saddle import BandedSaddle, SparseSum
+from fenics_drill.model.kernels.split_band import SplitBandedSaddle, StringSplit
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.reduction.enrichment import MODE_SPAN_TOLERANCE, augment, climbing_friction, enrich
 from fenics_drill.model.reduction.modes import reduction_bands, select_modes, solve_modes, stuck_bit_modes
@@ -237,14 +240,14 @@ class FullSpace:
         self.position[self.free] = np.arange(self.free.size)
         self._saddle = SaddleFactorisation(self._factorise)
         # the free dofs numbered along the string: an element couples only neighbours in this order
-        self._band_order = np.argsort(disc.dof_coordinates[self.free], kind="stable")
+        self.band_order = np.argsort(disc.dof_coordinates[self.free], kind="stable")
         # the tangent's bandwidth in that order: the farthest two free dofs of one element (a point force
         # couples the dofs of one vertex, which share an element)
         band_position = np.full(ndofs, -1, dtype=np.int64)
-        band_position[self.free[self._band_order]] = np.arange(self.free.size)
+        band_position[self.free[self.band_order]] = np.arange(self.free.size)
         cells = band_position[disc.V.dofmap.list]
         spread = np.where(cells >= 0, cells, -1).max(axis=1) - np.where(cells >= 0, cells, ndofs).min(axis=1)
-        self._band_width = int(spread.max())
+        self.band_width = int(spread.max())
         self.phi = sp.csr_matrix(
             (np.ones(self.free.size), (self.free, np.arange(self.free.size))), shape=(ndofs, self.free.size)
         )
@@ -294,7 +297,15 @@ class FullSpace:
         return SparseSum(terms, (self.size, self.size))
 
     def _factorise(self, tangent, constraints) -> BandedSaddle:
-        return BandedSaddle(tangent, constraints, self._band_order, self._band_width)
+        return BandedSaddle(tangent, constraints, self.band_order, self.band_width)
+
+    def split(self, string_split: StringSplit) -> "FullSpace":
+        """This space with its saddle system solved across the two ranks of ``string_split``
+        (:mod:`~fenics_drill.model.kernels.split_band`)."""
+        space = copy.copy(self)
+        space._saddle = SaddleFactorisation(
+            lambda tangent, constraints: SplitBandedSaddle(tangent, constraints, string_split, self.band_width))
+        return space
 
     def saddle_solve(self, tangent, constraints, rhs_q: np.ndarray, rhs_c: np.ndarray):
         """Solve [[J, B^T], [B, 0]] (dq, mu) = (rhs_q, rhs_c), Eq. (76), with a banded LU and the held dofs
