@@ -23,33 +23,71 @@ import scipy.linalg.lapack as lapack
 
 from fenics_drill.model.kernels.banded_saddle import BandLayout, band_order_positions, held_dofs
 from fenics_drill.model.kernels.compiled import kernel
+from numba import njit
 
 
-@kernel
-def _forward(lu, kl, ku, pivots, b, start):
-    """b <- L^-1 P b of dgbtrf's factors ``lu`` (band storage, 0-based ``pivots``), from column ``start`` on (b
-    is zero above ``start`` + kl, where the earlier columns change nothing)."""
-    n, kd = b.size, kl + ku
+@njit(cache=True)
+def _sweep_forward(lu, kl, ku, pivots, b, start):
+    """b <- L^-1 P b with dgbtrf's factors ``lu`` (band storage, 0-based ``pivots``), b holding the rows from
+    ``start`` on of a vector that is zero above ``start`` + kl (where the earlier columns change nothing)."""
+    n, kd = lu.shape[1], kl + ku
     for j in range(start, n - 1):
-        p = pivots[j]
-        if p != j:
-            b[j], b[p] = b[p], b[j]
-        value = b[j]
+        k, p = j - start, pivots[j] - start
+        if p != k:
+            b[k], b[p] = b[p], b[k]
+        value = b[k]
         if value != 0.0:
             for i in range(1, min(kl, n - j - 1) + 1):
-                b[j + i] -= lu[kd + i, j] * value
+                b[k + i] -= lu[kd + i, j] * value
+
+
+@njit(cache=True)
+def _sweep_backward(lu, kl, ku, b, start, stop):
+    """b <- U^-1 b in its rows from ``stop`` on, which depend on those rows of b only (b holding the rows from
+    ``start`` <= ``stop`` on; the rows above ``stop`` are left changed but not solved)."""
+    n, kd = lu.shape[1], kl + ku
+    for j in range(n - 1, stop - 1, -1):
+        b[j - start] /= lu[kd, j]
+        value = b[j - start]
+        for i in range(max(stop, j - kd), j):
+            b[i - start] -= lu[kd + i - j, j] * value
 
 
 @kernel
-def _backward(lu, kl, ku, b, stop):
-    """b[stop:] <- (U^-1 b)[stop:] of dgbtrf's factors ``lu`` (band storage): the rows from ``stop`` on of the
-    solution, which depend on those rows of b only (b above ``stop`` is left changed but not solved)."""
-    n, kd = b.size, kl + ku
-    for j in range(n - 1, stop - 1, -1):
-        b[j] /= lu[kd, j]
-        value = b[j]
-        for i in range(max(stop, j - kd), j):
-            b[i] -= lu[kd + i - j, j] * value
+def _schur_part(lu, kl, ku, pivots, tail, couple_columns, couple_rows):
+    """C_r A_r^-1 B_r from B_r's rows ``couple_columns`` and C_r's columns ``couple_rows`` from ``tail`` on (both
+    zero elsewhere): each column forward from a band's width above ``tail``, backward down to it."""
+    n, m, size = lu.shape[1], couple_columns.shape[0], couple_columns.shape[1]
+    start = max(tail - kl, 0)
+    out, work = np.empty((size, size)), np.empty(n - start)
+    for k in range(size):
+        work[:] = 0.0
+        work[tail - start: tail - start + m] = couple_columns[:, k]
+        _sweep_forward(lu, kl, ku, pivots, work, start)
+        _sweep_backward(lu, kl, ku, work, start, tail)
+        out[:, k] = np.dot(couple_rows, work[tail - start: tail - start + m])
+    return out
+
+
+@kernel
+def _condensed(lu, kl, ku, pivots, rhs, tail, couple_rows):
+    """rhs <- L^-1 P rhs (in place); returns C_r (A_r^-1 rhs) from its rows ``tail`` on."""
+    _sweep_forward(lu, kl, ku, pivots, rhs, 0)
+    part = rhs[tail:].copy()
+    _sweep_backward(lu, kl, ku, part, tail, tail)
+    return np.dot(couple_rows, part[: couple_rows.shape[1]])
+
+
+@kernel
+def _expanded(lu, kl, ku, pivots, rhs, tail, couple_columns, x_separator):
+    """rhs <- A_r^-1 (r - B_r x_S) from rhs = L^-1 P r (:func:`_condensed`)."""
+    n, m = lu.shape[1], couple_columns.shape[0]
+    start = max(tail - kl, 0)
+    work = np.zeros(n - start)
+    work[tail - start: tail - start + m] = np.dot(couple_columns, x_separator)
+    _sweep_forward(lu, kl, ku, pivots, work, start)
+    rhs[start:] -= work
+    _sweep_backward(lu, kl, ku, rhs, 0, 0)
 
 
 class StringSplit:
@@ -109,27 +147,19 @@ class SplitBandedSaddle:
         layout = BandLayout(split.local, taken, split.n, width, width, ("split", split.rank, id(split)),
                             shared_position=split.shared_local)
         band, columns, rows = layout.laid_out(tangent)
-        h = self.held_local.size
+        h, n, size = self.held_local.size, split.n, split.separator.size
         self.held_columns, self.held_rows = columns[:, :h], rows[:h]
-        sep = split.separator_local
-        self.couple_columns = columns[:, h:].copy()  # B_r: the separator's columns at this rank's rows
-        self.couple_columns[taken] = 0.0
-        self.couple_rows = rows[h:].copy()  # C_r: the separator's rows at this rank's columns
-        own_block = self.couple_rows[:, sep].copy()  # D_r
-        self.couple_rows[:, taken] = 0.0
+        # B_r and C_r: the separator's columns and rows at this rank's dofs, which lie within the band's width of
+        # it (the held dofs lie farther: checked above)
+        self.tail = max(n - size - width, 0)
+        self.couple_columns = np.ascontiguousarray(columns[self.tail:n - size, h:])
+        self.couple_rows = np.ascontiguousarray(rows[h:, self.tail:n - size])
+        own_block = rows[h:][:, split.separator_local]  # D_r
         self.lu, self.pivots, info = lapack.dgbtrf(band, width, width, overwrite_ab=1)
         if info != 0:
             raise np.linalg.LinAlgError(f"the saddle matrix (76) is singular (LAPACK dgbtrf info = {info})")
-        # the rows where B_r and C_r are not zero: within a band's width of the separator
-        coupled = np.flatnonzero(np.any(self.couple_columns != 0.0, axis=1) | np.any(self.couple_rows != 0.0, axis=0))
-        self.tail = int(coupled.min()) if coupled.size else split.n - sep.size
-        solved = np.empty((sep.size, sep.size))
-        for k in range(sep.size):
-            column = self.couple_columns[:, k].copy()
-            _forward(self.lu, width, width, self.pivots, column, max(self.tail - width, 0))
-            _backward(self.lu, width, width, column, self.tail)
-            solved[:, k] = self.couple_rows[:, self.tail:] @ column[self.tail:]
-        schur = np.empty_like(own_block)
+        solved = _schur_part(self.lu, width, width, self.pivots, self.tail, self.couple_columns, self.couple_rows)
+        schur = np.empty((size, size))  # C order, as the contiguous sum is sent
         comm.Allreduce(np.ascontiguousarray(own_block - solved), schur)
         self.schur = sla.lu_factor(schur, check_finite=False)
 
@@ -144,16 +174,11 @@ class SplitBandedSaddle:
             rhs[self.held_local] = x_held
         own_rhs = rhs[sep].copy() if split.rank == 0 else np.zeros(sep.size)  # r_S, counted once
         rhs[sep] = 0.0
-        _forward(self.lu, width, width, self.pivots, rhs, 0)
-        part = rhs.copy()
-        _backward(self.lu, width, width, part, self.tail)
         condensed = np.empty(sep.size)
-        split.comm.Allreduce(own_rhs - self.couple_rows[:, self.tail:] @ part[self.tail:], condensed)
+        split.comm.Allreduce(own_rhs - _condensed(self.lu, width, width, self.pivots, rhs, self.tail,
+                                                  self.couple_rows), condensed)
         x_sep = sla.lu_solve(self.schur, condensed, check_finite=False)
-        coupling = self.couple_columns @ x_sep
-        _forward(self.lu, width, width, self.pivots, coupling, max(self.tail - width, 0))
-        rhs -= coupling
-        _backward(self.lu, width, width, rhs, 0)
+        _expanded(self.lu, width, width, self.pivots, rhs, self.tail, self.couple_columns, x_sep)
         rhs[sep] = x_sep
         mine = rhs[: split.n - sep.size]  # this rank's dofs but the separator, in its numbering
         if split.rank == 0:
