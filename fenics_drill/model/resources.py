@@ -46,19 +46,32 @@ def available_memory() -> float | None:
         return None
 
 
+def ranks_on_this_machine() -> int:
+    """The MPI ranks this process shares the machine with, itself included, as the process manager tells them
+    (MPICH's MPI_LOCALNRANKS, Open MPI's OMPI_COMM_WORLD_LOCAL_SIZE); 1 outside mpiexec.  Each rank of a run, of
+    ``mc`` or of ``optimize`` holds a model of its own."""
+    for name in ("MPI_LOCALNRANKS", "OMPI_COMM_WORLD_LOCAL_SIZE"):
+        if os.environ.get(name, "").isdigit():
+            return max(int(os.environ[name]), 1)
+    return 1
+
+
 def check_memory(elements: int, element_degree: int) -> None:
-    """Refuse, before allocating, a mesh whose estimated memory exceeds what the machine has free."""
+    """Refuse, before allocating, a mesh whose estimated memory, once per rank on this machine
+    (:func:`ranks_on_this_machine`), exceeds what the machine has free."""
     available = available_memory()
     if available is None:
         return
-    need = estimated_memory(elements, element_degree)
+    ranks = ranks_on_this_machine()
+    need = ranks * estimated_memory(elements, element_degree)
     budget = USABLE_SHARE * available
     if need > budget:
         per_element = BYTES_PER_DOF * dof_count(1000, element_degree) / 1000
-        fits = max(int((budget - BASE_BYTES) / per_element), 0)
-        raise ResourceError(f"beam.elements = {elements} (degree {element_degree}) needs about {need / 1e9:.1f} GB, "
-                            f"more than the {available / 1e9:.1f} GB this machine has available: at most "
-                            f"beam.elements = {fits} fits")
+        fits = max(int((budget / ranks - BASE_BYTES) / per_element), 0)
+        on_ranks = f" on each of {ranks} ranks" if ranks > 1 else ""
+        raise ResourceError(f"beam.elements = {elements} (degree {element_degree}) needs about "
+                            f"{need / ranks / 1e9:.1f} GB{on_ranks}, more than the {available / 1e9:.1f} GB this "
+                            f"machine has available: at most beam.elements = {fits} fits")
 
 
 def check_disk(directory, need_bytes: float, what: str) -> None:

@@ -193,6 +193,24 @@ def test_a_mesh_beyond_the_machine_is_refused_before_allocating(tmp_path):
     assert not (tmp_path / "out").exists()  # refused before even the output directory is made
 
 
+def test_the_memory_check_counts_every_rank_on_the_machine(monkeypatch):
+    """Each rank of a run, mc or optimize holds a model of its own: a mesh that one process can hold with room to
+    spare is refused when as many ranks as the process manager says share the machine would need more than it has,
+    and the size it offers fits that many."""
+    from fenics_drill.model import resources
+
+    one = resources.estimated_memory(2000, 2)
+    monkeypatch.setattr(resources, "available_memory", lambda: 1.5 * one / resources.USABLE_SHARE)
+    monkeypatch.delenv("MPI_LOCALNRANKS", raising=False)
+    monkeypatch.delenv("OMPI_COMM_WORLD_LOCAL_SIZE", raising=False)
+    resources.check_memory(2000, 2)  # 1.5 times what it needs
+    monkeypatch.setenv("MPI_LOCALNRANKS", "2")
+    with pytest.raises(resources.ResourceError, match="on each of 2 ranks") as refused:
+        resources.check_memory(2000, 2)
+    fits = int(str(refused.value).rsplit("beam.elements = ", 1)[1].split()[0])
+    assert 2 * resources.estimated_memory(fits, 2) <= 1.5 * one < 2 * resources.estimated_memory(fits + 1, 2)
+
+
 def test_sigterm_inside_a_long_c_call_stops_the_run_within_the_grace_time(tmp_path):
     """60 000 elements: the worker sits in mesh building and the modal factorisation (minutes), where Python
     cannot see the signal; the tool ends it after its 5 s of grace and says so in the summary."""
