@@ -1,11 +1,14 @@
 """Strong scaling of one run over two MPI ranks: the same full-order string on 1 and 2 ranks, its costs and how far
 the two summaries lie apart.
 
-    python benchmarks/shared_run.py [--lengths 1000 3000] [--t-end 0.3] [--table benchmarks/results/shared_run.md]
+    python benchmarks/shared_run.py [--lengths 1000 3000] [--t-end 0.3]
+                                    [--well demos/scenes/well_vbh.toml --well-elements 6000]
+                                    [--table benchmarks/results/shared_run.md]
 
 Each length L runs `mpiexec -n P fenics-drill run demos/scenes/paper.toml --set beam.length=L --set
-beam.elements=2L --set time.t_end=T --set output.field_interval=0` for P = 1 and 2, one run at a time.  The
-speed-up is the one rank's integration time over the two ranks' (the set-up, the same on both ranks, is not
+beam.elements=2L --set time.t_end=T --set output.field_interval=0` for P = 1 and 2, one run at a time; ``--well``
+adds a well scene at its own length on ``--well-elements`` elements.  Peak memory is the largest rank's resident
+set (the kernel's accounting of mpiexec's children).  The speed-up is the one rank's integration time over the two ranks' (the set-up, the same on both ranks, is not
 split); "largest difference" is the largest relative difference between the two summaries' results (rop,
 efficiency, mean bit velocity, peak stress, stick-slip severity, hook load and surface torque, input and dissipated
 work, impacts).
@@ -15,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import platform
 import subprocess
 import sys
@@ -43,48 +47,57 @@ def numbers(summary: dict) -> dict:
     return out
 
 
-def run(length: float, t_end: float, ranks: int) -> dict:
+def run(scene: Path, sizes: list[str], t_end: float, ranks: int) -> dict:
+    """The summary of one run of ``scene`` with the ``sizes`` settings on ``ranks`` ranks, and its peak memory."""
     with tempfile.TemporaryDirectory() as out:
-        command = [str(MPIEXEC), "-n", str(ranks), sys.executable, "-m", "fenics_drill.cli", "run", str(PAPER),
-                   "--quiet", "--out", out, "--set", f"beam.length={length}", "--set",
-                   f"beam.elements={int(round(2 * length))}", "--set", f"time.t_end={t_end}", "--set",
-                   "output.field_interval=0"]
-        clock = time.perf_counter()
-        subprocess.run(command, stdout=subprocess.DEVNULL, check=True)
-        wall = time.perf_counter() - clock
-        return {**json.loads((Path(out) / "summary.json").read_text()), "command_wall_s": wall}
+        command = [str(MPIEXEC), "-n", str(ranks), sys.executable, "-m", "fenics_drill.cli", "run", str(scene),
+                   "--quiet", "--out", out, *sizes, "--set", f"time.t_end={t_end}", "--set", "output.field_interval=0"]
+        process = subprocess.Popen(command, stdout=subprocess.DEVNULL)
+        _, status, usage = os.wait4(process.pid, 0)
+        if status != 0:
+            raise RuntimeError(f"{' '.join(command)} ended with status {status}")
+        return {**json.loads((Path(out) / "summary.json").read_text()), "memory_gb": usage.ru_maxrss / 1e6}
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--lengths", type=float, nargs="+", default=[1000.0, 3000.0])
     parser.add_argument("--t-end", type=float, default=0.3)
+    parser.add_argument("--well", type=Path, default=None)
+    parser.add_argument("--well-elements", type=int, default=6000)
     parser.add_argument("--table", type=Path, default=ROOT / "benchmarks" / "results" / "shared_run.md")
     args = parser.parse_args()
+    cases = [(f"{length:g}", PAPER, ["--set", f"beam.length={length}", "--set",
+                                     f"beam.elements={int(round(2 * length))}"]) for length in args.lengths]
+    if args.well is not None:
+        cases.append((f"{args.well.stem} ({args.well_elements} elements)", args.well,
+                      ["--set", f"beam.elements={args.well_elements}"]))
     rows = []
-    for length in args.lengths:
-        one, two = (run(length, args.t_end, ranks) for ranks in (1, 2))
+    for name, scene, sizes in cases:
+        one, two = (run(scene, sizes, args.t_end, ranks) for ranks in (1, 2))
         a, b = numbers(one), numbers(two)
         differences = {k: abs(b[k] - a[k]) / max(abs(a[k]), 1e-300) for k in a if k in b and a[k] != 0.0}
         worst = max(differences, key=differences.get) if differences else ""
-        row = (f"| {length:g} | {one['reduced_size']} | {one['steps']} / {two['steps']} | "
+        row = (f"| {name} | {one['reduced_size']} | {one['steps']} / {two['steps']} | "
                f"{one['newton_iterations']} / {two['newton_iterations']} | {one['setup_time_s']:.1f} / "
                f"{two['setup_time_s']:.1f} | {one['integration_time_s']:.1f} / {two['integration_time_s']:.1f} | "
-               f"{one['integration_time_s'] / two['integration_time_s']:.2f} | "
-               f"{differences.get(worst, 0.0):.1e} ({worst}) |")
+               f"{one['integration_time_s'] / two['integration_time_s']:.2f} | {one['memory_gb']:.2f} / "
+               f"{two['memory_gb']:.2f} | {differences.get(worst, 0.0):.1e} ({worst}) |")
         rows.append(row)
         print(row, flush=True)
     lines = [
         "# One run on two MPI ranks",
         "",
-        f"`python benchmarks/shared_run.py --lengths {' '.join(f'{x:g}' for x in args.lengths)} --t-end {args.t_end:g}`"
+        f"`python benchmarks/shared_run.py --lengths {' '.join(f'{x:g}' for x in args.lengths)} --t-end {args.t_end:g}"
+        + (f" --well {args.well.relative_to(ROOT) if args.well.is_absolute() else args.well} --well-elements "
+           f"{args.well_elements}" if args.well is not None else "") + "`"
         f" on {platform.node()} ({platform.processor() or platform.machine()}, 2 cores), "
         f"{time.strftime('%Y-%m-%d')}: the paper's cross-section in the full order, 2 elements per metre, "
         f"{args.t_end:g} s simulated, one run at a time; each cell is 1 rank / 2 ranks.",
         "",
-        "| L [m] | unknowns | steps | Newton iterations | set-up [s] | integration [s] | speed-up | largest "
-        "difference of the summaries |",
-        "|---|---|---|---|---|---|---|---|",
+        "| L [m] | unknowns | steps | Newton iterations | set-up [s] | integration [s] | speed-up | peak memory "
+        "[GB] | largest difference of the summaries |",
+        "|---|---|---|---|---|---|---|---|---|",
         *rows,
         "",
     ]
