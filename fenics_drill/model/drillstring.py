@@ -204,7 +204,9 @@ class DrillstringModel:
     def split_over(self, comm) -> "DrillstringModel":
         """This full-order model with its elements shared between the two ranks of ``comm``: each assembles its own
         half's internal force and tangent, and the saddle system (76) is solved across both
-        (:mod:`~fenics_drill.model.kernels.split_band`).  Every rank steps the whole state alike."""
+        (:mod:`~fenics_drill.model.kernels.split_band`); the wall's law runs at each rank's own vertices
+        (:meth:`~fenics_drill.model.forces.wall_contact.WallContact.split_over`).  Every rank steps the whole state
+        alike."""
         if not self.space.sparse or not isinstance(self.internal, AssembledInternalForce):
             raise ValueError("a run splits its string over MPI ranks in the full order with its nonlinear internal "
                              "force only (reduction.rule = 'none', or 'auto' where it chooses the full order; "
@@ -215,6 +217,8 @@ class DrillstringModel:
         share = AssembledInternalForce(self.disc, model.space, self.operators, *self.internal.switches,
                                        cells=split.cells)
         model.internal = SplitInternalForce(self.internal, share, comm)
+        model.forces = [f.split_over(comm, split.owned_vertices) if hasattr(f, "split_over") else f
+                        for f in self.forces]
         model._kept_internal_tangent = None
         return model
 

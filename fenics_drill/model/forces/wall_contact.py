@@ -625,6 +625,9 @@ class WallContact:
         # the Coulomb force's memory at the last accepted state: each vertex's (u, v, w, theta_x) and friction
         # (F_a, F_t); None outside a run (a static state: no friction)
         self._history = None
+        # a full-order string split over MPI ranks: (comm, whether each vertex is this rank's); None: one rank
+        self._share = None
+        self._mine = None  # (vertex set, this rank's vertices among them, their rows) of the last shared evaluation
 
     @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "WallContact":
@@ -647,6 +650,15 @@ class WallContact:
         changed._kept_tangent = None
         changed._history = None
         return changed
+
+    def split_over(self, comm, owned: np.ndarray) -> "WallContact":
+        """A copy for a full-order string split over the ranks of ``comm`` (:mod:`~fenics_drill.model.kernels.
+        split_band`): the law runs at the vertices this rank ``owned`` only and the ranks' loads are summed, so
+        every rank holds the whole evaluation; the tangent is this rank's vertices' own.  The friction's memory,
+        updated at accepted steps only, stays every vertex's on every rank."""
+        split = copy.copy(self)
+        split._share, split._mine, split._near = (comm, owned), None, None
+        return split
 
     def begin(self, t: float, q: np.ndarray) -> None:
         """Start the Coulomb force's memory at the initial state: anchored at q, no force yet."""
@@ -714,6 +726,8 @@ class WallContact:
         compiled over the vertices that can reach the wall, and the law-by-law split is projected only
         when read.  The indentation is -inf at the vertices left out."""
         vertex_set = self._near_vertices(q) if self.culling else self.every
+        if self._share is not None:
+            return self._shared_evaluation(vertex_set, q, qd, with_tangent)
         if sp.issparse(vertex_set.flat):  # the full space: the rows select dofs
             positions = (vertex_set.flat @ q).reshape(-1, len(FIELDS))
             rates = (vertex_set.flat @ qd).reshape(-1, len(FIELDS))
@@ -725,6 +739,39 @@ class WallContact:
         return self.forces_of(vertex_set, (delta, nodal, laws, potential, generalised, positions, rates),
                               with_tangent)
 
+    def _shared_evaluation(self, vertex_set: VertexSet, q: np.ndarray, qd: np.ndarray,
+                           with_tangent: bool) -> WallForces:
+        """:meth:`evaluate` on a string split over ranks (:meth:`split_over`): the law at this rank's vertices of
+        ``vertex_set``; the generalised force, the indentations, the loads and the energy summed over the ranks in
+        one collective (each vertex is one rank's, so each sum has one term but the energy's)."""
+        comm, owned = self._share
+        if self._mine is None or self._mine[0] is not vertex_set:
+            mine = np.flatnonzero(owned[vertex_set.vertices])
+            rows = (len(FIELDS) * mine[:, None] + np.arange(len(FIELDS))).ravel()
+            self._mine = (vertex_set, mine, vertex_set.flat[rows])
+        _, mine, flat = self._mine
+        positions = (flat @ q).reshape(-1, len(FIELDS))
+        rates = (flat @ qd).reshape(-1, len(FIELDS))
+        delta_mine, nodal_mine, laws_mine, potential = _vertex_loads(positions, rates,
+                                                                     *self._law(vertex_set.vertices[mine]))
+        m, size, names = vertex_set.vertices.size, q.size, len(self.law_names)
+        ends = np.cumsum([size, m, m * len(FIELDS), m * len(FIELDS) * names, 1])
+        part = np.zeros(ends[-1])
+        generalised, delta, nodal, laws, energy = np.split(part, ends[:-1])
+        generalised[:] = flat.T @ nodal_mine.ravel()
+        delta.reshape(m)[mine] = delta_mine
+        nodal.reshape(m, len(FIELDS))[mine] = nodal_mine
+        laws.reshape(m, len(FIELDS), names)[mine] = laws_mine
+        energy[0] = potential
+        total = np.empty_like(part)
+        comm.Allreduce(part, total)
+        generalised, delta, nodal, laws, energy = np.split(total, ends[:-1])
+        out = self.forces_of(vertex_set, (delta, nodal.reshape(m, len(FIELDS)), laws.reshape(m, len(FIELDS), names),
+                                          float(energy[0]), generalised, None, None), False)
+        if with_tangent:
+            out.tangent_data = (flat, positions, rates, vertex_set.vertices[mine], delta_mine)
+        return out
+
     def forces_of(self, vertex_set: VertexSet, passed: tuple, with_tangent: bool) -> WallForces:
         """The evaluation of the vertices ``vertex_set`` from what :func:`_modal_pass` gives for them (also what a
         compiled Newton step hands back: solvers/compiled_step.py)."""
@@ -733,7 +780,7 @@ class WallContact:
         out = WallForces(generalised, potential, by_law, len(self.x), vertex_set.vertices, delta, nodal,
                          tangential_arm=self.arm if self.coulomb else None)
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
-            out.tangent_data = (vertex_set.flat, positions, rates, vertex_set.vertices)
+            out.tangent_data = (vertex_set.flat, positions, rates, vertex_set.vertices, delta)
         return out
 
     def evaluated_vertices(self) -> VertexSet:
@@ -761,8 +808,8 @@ class WallContact:
         Newton, and the residual, in double precision, decides when it has converged."""
         if forces.tangent_data is None:
             return None
-        flat, positions, rates, vertices = forces.tangent_data
-        active = np.flatnonzero(forces.delta > 0)
+        flat, positions, rates, vertices, delta = forces.tangent_data
+        active = np.flatnonzero(delta > 0)
         if active.size == 0:
             return None
         blocks = _contact_blocks(active, positions, rates, *self._law(vertices), c_u, c_v)
@@ -774,7 +821,7 @@ class WallContact:
             data = scale[:, :, None] * blocks * scale[:, None, :]
             kept = (rows >= 0) & (columns >= 0) & (data != 0.0)
             return sp.coo_matrix((data[kept], (rows[kept], columns[kept])), shape=(flat.shape[1],) * 2)
-        return self._updated_tangent(forces.vertices[active], blocks)
+        return self._updated_tangent(vertices[active], blocks)
 
     #: A vertex's block enters the modal tangent afresh when it changed by more than this share of the largest
     #: block since it last did; the tangent then differs from the exact one by less than that share of the

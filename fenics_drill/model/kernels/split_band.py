@@ -2,7 +2,7 @@
 
 Rank 0 holds the elements before the cut vertex, rank 1 those after it.  The dofs of the cut vertex (the
 separator S) are the only ones both ranks' elements hold.  Each rank lays out its own elements' tangent and
-the point forces at its own vertices (those at the cut on rank 0) with its dofs numbered towards the cut (rank 1
+the point forces at its own vertices (those at the cut on rank 0; the wall's law runs there only) with its dofs numbered towards the cut (rank 1
 from the far end), S last and taken out of the band like the drive's held dofs
 (:mod:`~fenics_drill.model.kernels.banded_saddle`), and factorises its band A_r with LAPACK's dgbtrf.  With
 B_r and C_r its columns and rows at S and D_r its own part of the S block,
@@ -119,11 +119,17 @@ class StringSplit:
                               self.local, -1)[space.free]
         self.n = separator[-1] + 1 if self.rank == 0 else n - separator[0]
         self.separator_local = separator if self.rank == 0 else n - 1 - separator
-        # the point forces every rank evaluates are laid out by the rank that owns their vertex: the cut's by rank 0
+        # the point forces every rank evaluates whole (the bit's, the drive's) are laid out by the rank that owns
+        # their vertex, the cut's by rank 0; the wall's law runs at each rank's own vertices (owned_vertices)
         self.shared_local = self.local.copy()
         if self.rank == 1:
             self.shared_local[np.isin(self.local, self.separator_local)] = -1
         self.free_along = space.band_order  # the free dof at each index along the string
+        # the point forces at vertices (the wall's) are evaluated by the rank that owns the vertex: the cut's by rank 0
+        cut = float(disc.dof_coordinates[space.free[space.band_order[separator]]].mean())
+        half_element = 0.5 * float(np.min(np.diff(np.sort(disc.vertex_x))))
+        self.owned_vertices = (disc.vertex_x <= cut + half_element) if self.rank == 0 else \
+            (disc.vertex_x > cut + half_element)
         self.free_of_local = np.empty(self.n, dtype=np.int64)
         mine = np.flatnonzero(self.local >= 0)
         self.free_of_local[self.local[mine]] = mine
