@@ -11,8 +11,9 @@ beam.elements=2L --set time.t_end=T --set output.field_interval=0` for P = 1 and
 ``--well-elements`` elements.  Peak memory is the largest rank's resident
 set (the kernel's accounting of mpiexec's children).  The times are the fastest of the repeats (a shared machine's
 pauses only lengthen a run), with the slowest over the fastest in brackets; the speed-up is the one rank's
-integration time over the two ranks' (the set-up, the same on both ranks, is not split); "largest difference" is the largest relative difference between the two summaries' results (rop,
-efficiency, mean bit velocity, peak stress, stick-slip severity, hook load and surface torque, input and dissipated
+integration time over the two ranks' (the set-up, the same on both ranks, is not split); "largest difference" is
+the largest relative difference between the two summaries' results (rop, efficiency, mean bit velocity, peak
+stress, stick-slip severity, hook load and surface torque, input and dissipated
 work, impacts).
 """
 

@@ -2,8 +2,8 @@
 
 Rank 0 holds the elements before the cut vertex, rank 1 those after it.  The dofs of the cut vertex (the
 separator S) are the only ones both ranks' elements hold.  Each rank lays out its own elements' tangent and
-the point forces at its own vertices (those at the cut on rank 0; the wall's law runs there only) with its dofs numbered towards the cut (rank 1
-from the far end), S last and taken out of the band like the drive's held dofs
+the point forces at its own vertices (those at the cut on rank 0; the wall's law runs there only) with its dofs
+numbered towards the cut (rank 1 from the far end), S last and taken out of the band like the drive's held dofs
 (:mod:`~fenics_drill.model.kernels.banded_saddle`), and factorises its band A_r with LAPACK's dgbtrf.  With
 B_r and C_r its columns and rows at S and D_r its own part of the S block,
 
