@@ -206,12 +206,14 @@ class DrillstringModel:
         half's internal force and tangent, and the saddle system (76) is solved across both
         (:mod:`~fenics_drill.model.kernels.split_band`); the wall's law runs at each rank's own vertices
         (:meth:`~fenics_drill.model.forces.wall_contact.WallContact.split_over`).  Every rank steps the whole state
-        alike."""
+        alike.  ValueError where the string cannot be split (its dofs do not part at one vertex, or the drive's lie
+        near the cut)."""
         if not self.space.sparse or not isinstance(self.internal, AssembledInternalForce):
             raise ValueError("a run splits its string over MPI ranks in the full order with its nonlinear internal "
                              "force only (reduction.rule = 'none', or 'auto' where it chooses the full order; "
                              "model.geometric_nonlinearity or model.inertial_nonlinearity on)")
         split = StringSplit(self.disc, self.space, comm)
+        split.check_drive(self.constraints, self.space.band_width)
         model = copy.copy(self)
         model.space = self.space.split(split)
         share = AssembledInternalForce(self.disc, model.space, self.operators, *self.internal.switches,

@@ -46,10 +46,15 @@ def why_not_split(model) -> str | None:
 
 
 def shared_model(model, comm):
-    """(the model the ranks step together, the summary's ``ranks`` entry)."""
+    """(the model the ranks step together, the summary's ``ranks`` entry): the string split between them, or the
+    model the first rank runs alone, with why (every rank decides alike)."""
     why = why_not_split(model)
-    report = {"ranks": comm.size, "split": why is None, **({"why": why} if why else {})}
-    return (model if why else model.split_over(comm)), report
+    if why is None:
+        try:
+            return model.split_over(comm), {"ranks": comm.size, "split": True}
+        except ValueError as refused:
+            why = str(refused)
+    return model, {"ranks": comm.size, "split": False, "why": why}
 
 
 def check_same_state(comm, q: np.ndarray) -> None:

@@ -135,3 +135,13 @@ def test_a_third_rank_is_refused_before_any_computation(tmp_path):
     code, _, err = _finished(_run(tmp_path / "run", 3), 300)
     assert code == 2
     assert "1 or 2 MPI ranks" in err
+
+
+def test_a_string_too_short_to_split_runs_on_the_first_rank_alone(tmp_path):
+    """Two elements: the drive's dofs lie within a band's width of the middle vertex, so the string cannot be cut
+    there; the first rank runs it alone and says why, the second writes nothing, and both end."""
+    code, _, err = _finished(_run(tmp_path / "run", 2, "--set", "beam.elements=2", "--set", "time.t_end=0.01"), 300)
+    assert code == 0, err
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["ranks"]["split"] is False and "too short to split" in summary["ranks"]["why"]
+    assert summary["steps"] > 0

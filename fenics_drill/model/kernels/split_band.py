@@ -134,6 +134,16 @@ class StringSplit:
         mine = np.flatnonzero(self.local >= 0)
         self.free_of_local[self.local[mine]] = mine
 
+    def check_drive(self, constraints, width: int) -> None:
+        """The drive's held dofs (the rows of [B]) must lie in the first rank's half, farther than a band's width
+        from the cut (ValueError otherwise: a string of a few elements)."""
+        along = np.full(self.size, -1, dtype=np.int64)
+        along[self.free_along] = np.arange(self.size)
+        held = along[held_dofs(constraints)[0]]
+        if held.max() >= self.separator[0] - width:
+            raise ValueError("the drive's dofs lie within a band's width of the cut between the ranks: the string is "
+                             "too short to split")
+
 
 class SplitBandedSaddle:
     """The saddle matrix [[J, B^T], [B, 0]] of (76) factorised across the two ranks of a :class:`StringSplit`:
@@ -142,11 +152,7 @@ class SplitBandedSaddle:
     def __init__(self, tangent, constraints, split: StringSplit, width: int):
         self.split, comm = split, split.comm
         held, self.coefficients = held_dofs(constraints)
-        local_held = split.local[held]
-        if split.rank == 0 and (np.any(local_held < 0) or local_held.max() >= split.separator_local[0] - width):
-            raise ValueError("the drive's held dofs lie at the cut between the ranks: the string is too short to split")
-        if split.rank == 1 and np.any(local_held >= 0):
-            raise ValueError("the drive's held dofs lie in the second rank's half of the string")
+        local_held = split.local[held]  # in the first rank's half (StringSplit.check_drive)
         self.held, self.held_local = held, local_held[local_held >= 0]
         self.kl = self.ku = width
         taken = np.concatenate([self.held_local, split.separator_local]).astype(np.int64)
