@@ -77,12 +77,15 @@ def stop_if_requested() -> None:
 
 
 @contextmanager
-def uninterrupted(stop_after: bool = True):
+def uninterrupted(stop_after: bool = True, comm=None):
     """A block that the active :class:`StopOnSignal` does not cut (a no-op outside one).  ``stop_after``
     (the recording of a step): KeyboardInterrupt comes as the block ends if a signal has arrived, inside it
     or before it (an interrupt raised where Python only prints exceptions, a destructor or a callback of a
     C library, would otherwise be lost, and the run would go on until the supervisor kills it); without it
-    (the writing of a summary), the signal is ignored."""
+    (the writing of a summary), the signal is ignored.  ``comm``: the ranks that take the steps of one run together
+    (:mod:`~fenics_drill.studies.shared_run`) tell each other at the end of the block whether a signal arrived, and
+    if one did on any of them, every rank raises KeyboardInterrupt after the same step (a rank that stopped alone
+    would leave the others waiting in the step's collectives)."""
     stop = StopOnSignal.active
     if stop is None:
         yield
@@ -92,31 +95,12 @@ def uninterrupted(stop_after: bool = True):
         yield
     finally:
         stop.deferring -= 1
+    if stop_after and comm is not None:
+        from mpi4py import MPI
+
+        stop.requested = comm.allreduce(stop.requested, op=MPI.LOR)
     if stop_after and stop.requested and not stop.deferring:
         raise KeyboardInterrupt
-
-
-@contextmanager
-def uninterrupted_together(comm):
-    """:func:`uninterrupted` for the ranks that take the steps of one run together
-    (:mod:`~fenics_drill.studies.shared_run`): at the end of the block the ranks tell each other whether a signal
-    arrived, and if one did on any of them, every rank raises KeyboardInterrupt after the same step (a rank that
-    stopped alone would leave the others waiting in the step's collectives)."""
-    from mpi4py import MPI
-
-    stop = StopOnSignal.active
-    if stop is None:
-        yield
-        return
-    stop.deferring += 1
-    try:
-        yield
-    finally:
-        stop.deferring -= 1
-    if comm.allreduce(stop.requested, op=MPI.LOR):
-        stop.requested = True
-        if not stop.deferring:
-            raise KeyboardInterrupt
 
 
 @contextmanager

@@ -37,7 +37,7 @@ from fenics_drill.solvers.static import StaticFailure, static_report
 from fenics_drill.model.resolution import band_frequency, mesh_advice
 from fenics_drill.solvers.step_control import StepTooSmall, nominal_step, steps_per_band_period
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
-from fenics_drill.studies.lifecycle import StopOnSignal, command_output, uninterrupted, uninterrupted_together
+from fenics_drill.studies.lifecycle import StopOnSignal, command_output, uninterrupted
 from fenics_drill.studies.prepare import prepare
 from fenics_drill.studies.shared_run import check_ranks, check_same_state, second_rank_run, shared_model
 from fenics_drill.studies.torque_drag import fe_static_profiles, write_path_vtu
@@ -276,7 +276,7 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
             if comm.size > 1:
                 model, summary["ranks"] = shared_model(model, comm)
                 if summary["ranks"]["split"]:
-                    atomic = functools.partial(uninterrupted_together, comm)
+                    atomic = functools.partial(uninterrupted, comm=comm)
             simulation = Simulation(model, scene)
             start = simulation.initial_state(equilibrium.q)
             if atomic is not uninterrupted:

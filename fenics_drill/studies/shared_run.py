@@ -8,7 +8,7 @@ and takes the same steps; the first writes the files and the summary, the other 
 (modal) model, which runs near real time on one core, is not split: the first rank runs it alone.
 
 A signal on any rank stops both after the same step (:func:`~fenics_drill.studies.lifecycle.
-uninterrupted_together`); an error on one rank alone ends the job (the command line's MPI_Abort).
+uninterrupted` with ``comm``); an error on one rank alone ends the job (the command line's MPI_Abort).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from fenics_drill.model.internal_force import AssembledInternalForce
 from fenics_drill.solvers.static import StaticFailure
 from fenics_drill.solvers.step_control import StepTooSmall
 from fenics_drill.solvers.time_loop import Simulation
-from fenics_drill.studies.lifecycle import StopOnSignal, uninterrupted_together
+from fenics_drill.studies.lifecycle import StopOnSignal, uninterrupted
 from fenics_drill.studies.prepare import prepare
 
 
@@ -79,7 +79,7 @@ def second_rank_run(scene, comm, refused: str | None) -> dict:
             simulation = Simulation(model, scene)
             start = simulation.initial_state(prepared.equilibrium.q)
             check_same_state(comm, start.q)
-            simulation.run(start, scene.time.t_end, atomic=lambda: uninterrupted_together(comm))
+            simulation.run(start, scene.time.t_end, atomic=lambda: uninterrupted(comm=comm))
             summary.update(status="finished", message="reached time.t_end")
         except StepTooSmall as failure:
             summary["message"] = str(failure)
