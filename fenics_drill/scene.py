@@ -207,6 +207,9 @@ class Model:
                           choices=("objective", "printed"))
     angular_velocity: str = key("consistent", "angular velocity in the kinetic energy (24): 'consistent' or "
                                 "'printed' (13)", choices=("consistent", "printed"))
+    torsion: str = key("st_venant", "torsional stiffness: 'st_venant' (G J of a round tube) or 'printed' (the "
+                       "paper's kappa_s G J, which Table 4's mode counts use; docs/errata.md)",
+                       choices=("st_venant", "printed"))
 
 
 def _positions(x) -> bool:
@@ -339,6 +342,7 @@ SECTION_KEYS = {
     "poisson_ratio": "Poisson ratio [-] (default beam.poisson_ratio)",
     "tool_joint_outer_radius": "outer radius of the tool joints, the contact radius where they touch the wall [m] "
                                "(0: none)",
+    "tool_joint_inner_radius": "inner radius of the tool joints [m] (default the body's inner_radius)",
     "tool_joint_length": "length of one tool joint [m]",
     "tool_joint_spacing": "distance between tool joints, one joint of pipe [m]",
 }
@@ -374,6 +378,13 @@ def _string_sections(sections) -> bool:
                              f"outer_radius = {section['outer_radius']!r} (or 0 for none)")
         if joint and not (section.get("tool_joint_length", 0) > 0 and section.get("tool_joint_spacing", 0) > 0):
             raise SceneError(f"{where}: a tool joint needs tool_joint_length > 0 and tool_joint_spacing > 0")
+        if joint and section["tool_joint_length"] > section["tool_joint_spacing"]:
+            raise SceneError(f"{where}.tool_joint_length = {section['tool_joint_length']!r} is not admissible: must be "
+                             f"<= tool_joint_spacing = {section['tool_joint_spacing']!r} (a joint is part of its pipe)")
+        joint_inner = section.get("tool_joint_inner_radius")
+        if joint_inner is not None and not (joint and joint_inner < joint):
+            raise SceneError(f"{where}.tool_joint_inner_radius = {joint_inner!r} is not admissible: needs a "
+                             f"tool_joint_outer_radius above it")
     return True
 
 
@@ -473,6 +484,7 @@ class Scene:
             young_modulus=b.young_modulus, poisson_ratio=b.poisson_ratio, shear_factor=b.shear_factor,
             damping=b.damping, gravity=self.environment.gravity * self.buoyancy_factor if self.model.gravity else 0.0,
             lateral_added_mass=self.lateral_added_mass, lateral_fluid_damping=self.fluid.lateral_damping,
+            torsion=self.model.torsion,
         )
 
     @property

@@ -95,11 +95,22 @@ def linear_strains(s: dict) -> tuple[SectionPolynomial, SectionPolynomial, Secti
 
 def strain_energy_density(p: BeamProperties, s: dict, geometric_nonlinearity: bool = True,
                           kinematics: str = "objective"):
-    """Strain energy per unit length, Eq. (30): 1/2 int_S (E e_xx^2 + 4 ks G (e_xy^2 + e_xz^2)) dA."""
+    """Strain energy per unit length, Eq. (30), with the shear factor on the transverse shear only:
+    1/2 int_S E e_xx^2 dA + 2 G [int_S (e_xy^2 + e_xz^2) dA - (1 - ks) (m_xy^2 + m_xz^2) / A], m = int_S e dA.
+    The section's mean shear strain carries ks (Timoshenko's correction); what varies over the section, the
+    St-Venant torsion, does not (its stiffness is G J; docs/errata.md, "Torsional stiffness").  With
+    ``p.torsion = 'printed'`` the whole shear energy carries ks, as (30) is printed."""
     exx, exy, exz = green_lagrange_strains(s, kinematics) if geometric_nonlinearity else linear_strains(s)
-    E, kG = p.young_modulus, p.shear_factor * p.shear_modulus
+    E, G, ks = p.young_modulus, p.shear_modulus, p.shear_factor
     ro, ri = p.outer_radius, p.inner_radius
-    return 0.5 * (E * (exx * exx).integrate(ro, ri) + 4.0 * kG * (exy * exy + exz * exz).integrate(ro, ri))
+    factors = (p.area_stiffness_factor, p.inertia_stiffness_factor, p.sixth_moment_stiffness_factor)
+    axial = E * (exx * exx).integrate(ro, ri, factors)
+    shear = (exy * exy + exz * exz).integrate(ro, ri, factors)
+    if p.torsion == "printed":
+        return 0.5 * axial + 2.0 * ks * G * shear
+    area = p.stiffness_section.area
+    mean_xy, mean_xz = exy.integrate(ro, ri, factors), exz.integrate(ro, ri, factors)
+    return 0.5 * axial + 2.0 * G * (shear - (1.0 - ks) * (mean_xy**2 + mean_xz**2) / area)
 
 
 #: Angular velocity of the section (docs/errata.md, "Angular velocity (13)"): 'consistent' takes the
@@ -129,7 +140,7 @@ def kinetic_energy_density(p: BeamProperties, U, V, inertial_nonlinearity: bool 
     s = p.section
     w1, w2, w3 = angular_velocity(U, V, inertial_nonlinearity, angular_velocity_form)
     translational = 0.5 * p.density * s.area * (V[0] ** 2 + V[1] ** 2 + V[2] ** 2)
-    rotational = 0.5 * p.density * s.I4 * (2.0 * w1**2 + w2**2 + w3**2)
+    rotational = 0.5 * p.density * s.I4 * p.rotary_inertia_factor * (2.0 * w1**2 + w2**2 + w3**2)
     fluid = 0.5 * p.lateral_added_mass * (V[1] ** 2 + V[2] ** 2)
     return translational + rotational + fluid
 
@@ -138,7 +149,8 @@ def dissipation_density(p: BeamProperties, V):
     """Dissipation function per unit length, Eq. (38), plus the fluid's lateral viscous damping."""
     s = p.section
     return 0.5 * p.damping * p.density * (
-        s.area * (V[0] ** 2 + V[1] ** 2 + V[2] ** 2) + s.I4 * (2.0 * V[3] ** 2 + V[4] ** 2 + V[5] ** 2)
+        s.area * (V[0] ** 2 + V[1] ** 2 + V[2] ** 2)
+        + s.I4 * p.rotary_inertia_factor * (2.0 * V[3] ** 2 + V[4] ** 2 + V[5] ** 2)
     ) + 0.5 * p.lateral_fluid_damping * (V[1] ** 2 + V[2] ** 2)
 
 

@@ -19,7 +19,7 @@ def _inertia_pairing(p: BeamProperties, psi, U):
     rho = p.density
     translational = psi[0] * U[0] + psi[1] * U[1] + psi[2] * U[2]
     rotational = 2.0 * psi[3] * U[3] + psi[4] * U[4] + psi[5] * U[5]
-    return rho * s.area * translational + rho * s.I4 * rotational
+    return rho * s.area * translational + rho * s.I4 * p.rotary_inertia_factor * rotational
 
 
 def _lateral_pairing(psi, U):
@@ -40,17 +40,19 @@ def damping_form(p: BeamProperties, psi, U, dx):
 def stiffness_form(p: BeamProperties, psi, U, dx):
     """Stiffness operator K(psi, U), Eq. (46).
 
-    Axial E A u'; bending E I4 theta_y', theta_z'; torsion 2 kappa_s G I4 theta_x';
-    shear kappa_s G A (theta_y + w') and (theta_z - v'); on a curved axis the derivatives are the frame's
-    (:func:`~fenics_drill.forms.energies.axial_derivatives`).
+    Axial E A u'; bending E I4 theta_y', theta_z'; torsion G J theta_x' with J = 2 I4 (St-Venant; the printed
+    2 kappa_s G I4 with ``p.torsion = 'printed'``, docs/errata.md); shear kappa_s G A (theta_y + w') and
+    (theta_z - v'); on a curved axis the derivatives are the frame's
+    (:func:`~fenics_drill.forms.energies.axial_derivatives`).  A, I4 are the stiffness section's
+    (:attr:`~fenics_drill.forms.properties.BeamProperties.stiffness_section`).
     """
-    s = p.section
+    s = p.stiffness_section
     E, G, ks = p.young_modulus, p.shear_modulus, p.shear_factor
     du, dv, dw, dtx, dty, dtz = axial_derivatives(U, p.axis)
     dpu, dpv, dpw, dptx, dpty, dptz = axial_derivatives(psi, p.axis)
     axial = E * s.area * dpu * du
     bending = E * s.I4 * (dpty * dty + dptz * dtz)
-    torsion = 2.0 * ks * G * s.I4 * dptx * dtx
+    torsion = p.torsional_rigidity * dptx * dtx
     shear = ks * G * s.area * ((psi[4] + dpw) * (U[4] + dw) + (psi[5] - dpv) * (U[5] - dv))
     return (axial + bending + torsion + shear) * dx
 

@@ -15,7 +15,7 @@ GAMMA_SLOTS = ("theta_x", "theta_y", "theta_z", "du", "dv", "dw", "dtheta_x", "d
 
 def printed_inertial_nonlinear_force(p: BeamProperties, psi, U, V, A, dx):
     """F_KE(psi), Eq. (48) as printed."""
-    rI = p.density * p.section.I4
+    rI = p.density * p.section.I4 * p.rotary_inertia_factor
     tx, ty = U[3], U[4]
     vx, vy, vz = V[3], V[4], V[5]
     ax, az = A[3], A[5]
@@ -29,7 +29,7 @@ def printed_inertial_nonlinear_force(p: BeamProperties, psi, U, V, A, dx):
 
 def printed_gammas(p: BeamProperties, s: dict) -> dict:
     """Gamma_1..Gamma_9 of Appendix A as printed, keyed by the slot they multiply in (49)."""
-    sec = p.section
+    sec = p.stiffness_section
     E, kG = p.young_modulus, p.shear_factor * p.shear_modulus
     EA, EI4, EI6, kGA, kGI4 = E * sec.area, E * sec.I4, E * sec.I6, kG * sec.area, kG * sec.I4
     S, C = ufl.sin(s["theta_x"]), ufl.cos(s["theta_x"])

@@ -40,6 +40,10 @@ class CurvedAxis:
     down: tuple
 
 
+#: The torsional stiffness: St-Venant's G J, or the paper's kappa_s G J (Table 4's torsional wave speed).
+TORSION = ("st_venant", "printed")
+
+
 @dataclass(frozen=True)
 class BeamProperties:
     """Everything the beam forms need, in SI units.
@@ -63,6 +67,20 @@ class BeamProperties:
     lateral_added_mass: float = 0.0  # fluid moving with the lateral motion (v, w) [kg/m]
     lateral_fluid_damping: float = 0.0  # viscous force per length and lateral velocity [N s/m^2]
     axis: CurvedAxis | None = field(default=None, compare=False)  # a well's axis; None: straight, horizontal
+    #: 'st_venant': the torsional stiffness G J of a round tube (no shear correction); 'printed': the paper's
+    #: kappa_s G J (docs/errata.md, "Torsional stiffness").
+    torsion: str = "st_venant"
+    #: Tool joints homogenised over their pitch (docs/wells.md): the stiffness moments A, I4, I6 of the body
+    #: times these factors (series compliance of body and joint), and the rotary inertia rho I4 times
+    #: ``rotary_inertia_factor`` (the pitch's mean rho I4 over the body's rho I4, with rho the cell's density).
+    area_stiffness_factor: float = 1.0
+    inertia_stiffness_factor: float = 1.0
+    sixth_moment_stiffness_factor: float = 1.0
+    rotary_inertia_factor: float = 1.0
+
+    def __post_init__(self):
+        if self.torsion not in TORSION:
+            raise ValueError(f"unknown torsion {self.torsion!r}; expected one of {TORSION}")
 
     @property
     def section(self) -> SectionConstants:
@@ -74,14 +92,36 @@ class BeamProperties:
         return self.young_modulus / (2.0 * (1.0 + self.poisson_ratio))
 
     @property
+    def torsional_modulus(self):
+        """The modulus of the torsional stiffness: G (St-Venant) or kappa_s G (the paper's, ``torsion='printed'``)."""
+        return self.shear_modulus if self.torsion == "st_venant" else self.shear_factor * self.shear_modulus
+
+    @property
+    def stiffness_section(self) -> SectionConstants:
+        """A, I4, I6 of the section as the stiffness sees them: the body's, stiffened by homogenised tool joints."""
+        s = self.section
+        return SectionConstants(s.area * self.area_stiffness_factor, s.I4 * self.inertia_stiffness_factor,
+                                s.I6 * self.sixth_moment_stiffness_factor)
+
+    @property
+    def torsional_rigidity(self):
+        """G J = G (2 I4) of St-Venant torsion (kappa_s G J with ``torsion='printed'``) [N m^2]."""
+        return self.torsional_modulus * 2.0 * self.stiffness_section.I4
+
+    @property
+    def polar_inertia_per_length(self):
+        """rho J = rho (2 I4) times the tool joints' rotary factor [kg m]."""
+        return self.density * 2.0 * self.section.I4 * self.rotary_inertia_factor
+
+    @property
     def longitudinal_wave_speed(self) -> float:
         """c_L = sqrt(E / rho), used in the dimensionless frequency (95)."""
         return math.sqrt(self.young_modulus / self.density)
 
     @property
     def torsional_wave_speed(self) -> float:
-        """sqrt(2 kappa_s G I4 / (2 rho I4)) = sqrt(kappa_s G / rho) for the model's torsion."""
-        return math.sqrt(self.shear_factor * self.shear_modulus / self.density)
+        """sqrt(G J / rho J): sqrt(G / rho) for a plain tube (sqrt(kappa_s G / rho) with ``torsion='printed'``)."""
+        return math.sqrt(self.torsional_rigidity / self.polar_inertia_per_length)
 
     @property
     def mass_per_length(self) -> float:

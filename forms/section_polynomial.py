@@ -50,11 +50,12 @@ class SectionPolynomial:
                 terms[key] = terms[key] + c1 * c2 if key in terms else c1 * c2
         return SectionPolynomial(terms)
 
-    def integrate(self, outer_radius: float, inner_radius: float):
-        """int_S p(y, z) dy dz, exactly."""
+    def integrate(self, outer_radius: float, inner_radius: float, degree_factors=(1.0, 1.0, 1.0)):
+        """int_S p(y, z) dy dz, exactly; the moments of degree 0, 2 and 4 (those of A, I4 and I6) times
+        ``degree_factors`` (a section stiffened by homogenised tool joints: :attr:`BeamProperties.stiffness_section`)."""
         total = 0.0
         for (a, b), c in self.terms.items():
             m = annulus_moment(a, b, outer_radius, inner_radius)
             if m != 0.0:
-                total = total + m * c
+                total = total + degree_factors[(a + b) // 2] * m * c
         return total

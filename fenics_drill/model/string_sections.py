@@ -2,10 +2,14 @@
 properties a torque-and-drag or buckling model needs: section moments, weight in air and in the mud (buoyancy of
 the fluid outside and inside), and the contact radius (the tool joints', where they touch the wall).
 
-Tool joints count as added steel: a joint of outer radius R_tj and length l every ``spacing`` adds
-pi (R_tj^2 - R^2) l / spacing of steel area per length to the weight and to the displaced mud, and makes R_tj
-the radius at which the pipe meets the wall.  The buoyed weight per length is
-g (rho_s A_steel + rho_in A_in - rho_out A_out) (Archimedes, the effective-tension convention of Lubinski).
+Tool joints: a joint of outer radius R_tj, inner radius r_tj (the body's unless given) and length l every
+``spacing`` takes the share f = l / spacing of the pipe.  The steel area, the displaced and the inner area per
+length are the means over the pitch, (1 - f) A_body + f A_joint, and R_tj is the radius at which the pipe meets
+the wall.  The buoyed weight per length is g (rho_s A_steel + rho_in A_in - rho_out A_out) (Archimedes, the
+effective-tension convention of Lubinski).  For the FE string the joints are homogenised over the pitch
+(docs/wells.md, "Tool joints"): body and joint in series for the stiffness, 1 / K = (1 - f) / K_body + f / K_joint
+for each of E A, E I, G J (and the moment I6 of the nonlinear terms), and the mean inertia rho A, rho J over the
+pitch: exact for waves much longer than the pitch.
 """
 
 from __future__ import annotations
@@ -35,6 +39,10 @@ class StringSection:
     mass_per_length: float  # steel, tool joints included [kg/m]
     displaced_area: float  # outer area, tool joints included [m^2]
     inner_area: float  # [m^2]
+    #: The homogenised joints' stiffness over the body's, for A, I4 and I6 (series compliance; 1 without joints).
+    stiffness_factors: tuple = (1.0, 1.0, 1.0)
+    #: The pitch's mean rho I4 over the body's rho I4 times the density ratio mass_per_length / (rho A_body).
+    rotary_inertia_factor: float = 1.0
 
     @property
     def bending_stiffness(self) -> float:
@@ -57,13 +65,21 @@ def string_sections(scene) -> list[StringSection]:
         density = raw.get("density", beam.density)
         outer, inner = raw["outer_radius"], raw["inner_radius"]
         joint = raw.get("tool_joint_outer_radius", 0.0)
-        extra = math.pi * (joint**2 - outer**2) * raw["tool_joint_length"] / raw["tool_joint_spacing"] if joint else 0.0
-        steel = math.pi * (outer**2 - inner**2) + extra
+        share = raw["tool_joint_length"] / raw["tool_joint_spacing"] if joint else 0.0
+        joint_inner = raw.get("tool_joint_inner_radius", inner) if joint else inner
+        body, joint_section = section_constants(outer, inner), section_constants(joint or outer, joint_inner)
+        mean = lambda b, j: (1.0 - share) * b + share * j  # noqa: E731  (the pitch's mean)
+        steel = mean(body.area, joint_section.area)
+        stiffness = tuple(1.0 / mean(1.0, b / j) for b, j in ((body.area, joint_section.area),
+                                                               (body.I4, joint_section.I4), (body.I6, joint_section.I6)))
+        rotary = mean(1.0, joint_section.I4 / body.I4) / (steel / body.area)
         out.append(StringSection(
             name=str(raw.get("name", "section")), top=top, bottom=top + raw["length"], outer_radius=outer,
             inner_radius=inner, density=density, young_modulus=raw.get("young_modulus", beam.young_modulus),
             poisson_ratio=raw.get("poisson_ratio", beam.poisson_ratio), contact_radius=joint or outer,
-            mass_per_length=density * steel, displaced_area=math.pi * outer**2 + extra, inner_area=math.pi * inner**2))
+            mass_per_length=density * steel, displaced_area=math.pi * mean(outer**2, (joint or outer) ** 2),
+            inner_area=math.pi * mean(inner**2, joint_inner**2), stiffness_factors=stiffness,
+            rotary_inertia_factor=rotary))
         top += raw["length"]
     return out
 
@@ -93,10 +109,10 @@ class FESections:
 
 def fe_sections(scene, hole_radius_at, cell_x: np.ndarray, vertex_x: np.ndarray) -> FESections:
     """The scene's string (:func:`string_sections`) on cells with midpoints ``cell_x`` and on vertices ``vertex_x``,
-    in a hole whose radius at measured depth s is ``hole_radius_at(s)``.  Tool joints are added steel spread along
-    the pipe (the density rises by the joints' share, in the translational and rotational inertia alike) and the
-    contact radius where they are; at a vertex between two sections the larger contact radius.  Raises SceneError
-    where a section does not fit the hole."""
+    in a hole whose radius at measured depth s is ``hole_radius_at(s)``.  Tool joints are homogenised over their
+    pitch: the density carries their steel, the stiffness and rotary-inertia factors their stiffness and polar
+    inertia (module doc), and they give the contact radius; at a vertex between two sections the larger contact
+    radius.  Raises SceneError where a section does not fit the hole."""
     sections = string_sections(scene)
     g = scene.environment.gravity if scene.model.gravity else 0.0
     outer_fluid, inner_fluid = scene.fluid.density, scene.inner_fluid_density
@@ -112,7 +128,11 @@ def fe_sections(scene, hole_radius_at, cell_x: np.ndarray, vertex_x: np.ndarray)
         "poisson_ratio": np.array([s.poisson_ratio for s in sections])[k],
         "gravity": g * (buoyed / mass)[k],
         "lateral_added_mass": scene.lateral_added_mass_of(outer[k], inner[k], hole_radius_at(cell_x)),
+        "rotary_inertia_factor": np.array([s.rotary_inertia_factor for s in sections])[k],
     }
+    factors = np.array([s.stiffness_factors for s in sections])
+    for i, name in enumerate(("area_stiffness_factor", "inertia_stiffness_factor", "sixth_moment_stiffness_factor")):
+        cells[name] = factors[k, i]
     contact = np.array([s.contact_radius for s in sections])
     length = sections[-1].bottom
     step = 1e-9 * length

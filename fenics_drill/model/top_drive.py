@@ -55,7 +55,7 @@ def controller_gains(drive, properties) -> tuple[float, float]:
     if drive.controller != "soft_torque":
         return drive.proportional_gain, drive.integral_gain
     c_t = properties.torsional_wave_speed
-    impedance = properties.density * 2.0 * properties.section.I4 * c_t
+    impedance = properties.polar_inertia_per_length * c_t
     omega_s = 2.0 * math.pi * c_t / (4.0 * properties.length)
     return impedance, omega_s**2 * drive.top_drive_inertia
 

@@ -2,7 +2,8 @@
 per length, from a state's vertex values; the force and torque the drive applies at the top, from the series.
 
 Along each element between two vertices the axial force is E A eps (1 + u') with the Green-Lagrange stretch
-eps = u' + (u'^2 + v'^2 + w'^2) / 2 (on a well's curved axis, u' - k2 v - k3 w in the axis' frame) and the torque the model's torsional stiffness kappa_s G (2 I4) times theta_x', from
+eps = u' + (u'^2 + v'^2 + w'^2) / 2 (on a well's curved axis, u' - k2 v - k3 w in the axis' frame) and the torque
+the model's torsional stiffness G J times theta_x' (:attr:`~fenics_drill.forms.properties.BeamProperties.torsional_rigidity`), from
 the vertex values (the element's mean strain); the wall's normal force at a vertex is its spring force
 k_FS1 delta + k_FS2 delta^3 (Eq. 17 without the damper) over the length the vertex stands for.
 """
@@ -29,10 +30,10 @@ def string_profiles(x, u, v, w, theta_x, properties, gap: float, stiffness_linea
         mean = lambda a: 0.5 * (a[1:] + a[:-1])  # noqa: E731
         du = du - k2 * mean(v) - k3 * mean(w)
         dt = dt - k2 * mean(np.asarray(theta_y)[order]) - k3 * mean(np.asarray(theta_z)[order])
-    s = properties.section
+    s = properties.stiffness_section
     # the force along the axis, dW/du' = E A eps (1 + u'), eps the Green-Lagrange stretch (what the top holds)
     axial = properties.young_modulus * s.area * (du + 0.5 * (du**2 + dv**2 + dw**2)) * (1.0 + du)
-    torque = properties.shear_factor * properties.shear_modulus * 2.0 * s.I4 * dt
+    torque = properties.torsional_rigidity * dt
     delta = np.hypot(v, w) - (np.asarray(gap)[order] if np.ndim(gap) else gap)
     spring = np.where(delta > 0, stiffness_linear * delta + stiffness_cubic * delta**3, 0.0)
     tributary = np.concatenate([[h[0] / 2], 0.5 * (h[1:] + h[:-1]), [h[-1] / 2]])

@@ -192,12 +192,16 @@ def outer_fibre(outer_radius: float, angles: int = SECTION_ANGLES) -> np.ndarray
 
 def _section_scales(disc: BeamDiscretization) -> list:
     """For a string of sections, the factor of each strain coefficient (eps_xx, eps_xy, eps_xz times y^a z^b) that
-    makes the stress of the section at the bit (E, G, R_ext of :attr:`~BeamDiscretization.properties`) the cell's:
-    E_cell / E (G_cell / G for the shears) times (R_cell / R_ext)^(a + b), as UFL coefficients."""
+    makes the stress of the section at the bit (E, G, R_ext of :attr:`~BeamDiscretization.properties`) the cell's
+    pipe body's: E_cell / E (G_cell / G for the shears) times (R_cell / R_ext)^(a + b), times the homogenised tool
+    joints' stiffness factor (the body carries the pitch's force and moment on its own section: its strain is the
+    pitch's mean strain times A_pitch / A_body for a + b = 0, I_pitch / I_body above), as UFL coefficients."""
     p, cell = disc.properties, disc.form_properties
     moduli = (cell.young_modulus / p.young_modulus, cell.shear_modulus / p.shear_modulus,
               cell.shear_modulus / p.shear_modulus)
-    return [modulus * (cell.outer_radius / p.outer_radius) ** (a + b) for modulus in moduli for a, b in MONOMIALS]
+    body = (cell.area_stiffness_factor, cell.inertia_stiffness_factor)
+    return [modulus * body[min(a + b, 1)] * (cell.outer_radius / p.outer_radius) ** (a + b)
+            for modulus in moduli for a, b in MONOMIALS]
 
 
 class VonMisesProbe:

@@ -90,7 +90,7 @@ def rod_solution(trajectory, s_out, properties, weight_per_length):
     the six forces and moments at the top found from the six conditions at the bottom."""
     p = properties
     ea, ei = p.young_modulus * p.section.area, p.young_modulus * p.section.I4
-    kga, gj = p.shear_factor * p.shear_modulus * p.section.area, 2 * p.shear_factor * p.shear_modulus * p.section.I4
+    kga, gj = p.shear_factor * p.shear_modulus * p.section.area, 2 * p.shear_modulus * p.section.I4  # St-Venant
     top = trajectory.bishop_frames([0.0])
     k2, k3 = float(top.k2[0]), float(top.k3[0])
     u, v, w, tx, ty, tz, n, q2, q3, mt, m2, m3, gt, g2, g3 = range(15)

@@ -70,8 +70,9 @@ def test_a_composite_string_hangs_with_its_buoyed_weight_and_stretches_section_b
     """Collar below drill pipe with tool joints, in a vertical hole in mud: the hook load is the sum of each
     section's buoyed weight (tool joints included, 1e-9), and in air, with linear strains, each section stretches
     under the weight below it, sum_k (T_k L_k + w_k L_k^2 / 2) / (E A_k) with T_k the weight hanging below
-    section k, and carries the stress T(x) / A(x) (1e-9: u is quadratic in each section, which the quadratic
-    elements hold exactly)."""
+    section k, and carries the stress T(x) / A(x) in its body (1e-9: u is quadratic in each section, which the
+    quadratic elements hold exactly).  The pipe's tool joints (OD 168 mm, 0.45 m every 9.4 m) stiffen it in series
+    with its body: E A = E / ((1 - f) / A_body + f / A_joint), f = 0.45 / 9.4."""
     joint = dict(PIPE, tool_joint_outer_radius=0.084, tool_joint_length=0.45, tool_joint_spacing=9.4)
     for mud, strains in ((1200.0, "true"), (0.0, "false")):
         scene = sectioned([COLLAR, joint], "beam.elements=100", f"fluid.density={mud}",
@@ -88,6 +89,9 @@ def test_a_composite_string_hangs_with_its_buoyed_weight_and_stretches_section_b
     below, stretch = 0.0, 0.0
     for s, w, l in reversed(list(zip(sections, weights, lengths))):
         area = math.pi * (s.outer_radius**2 - s.inner_radius**2)
+        if s.contact_radius > s.outer_radius:  # the jointed pipe: body and joint in series over the pitch
+            f = 0.45 / 9.4
+            area = 1.0 / ((1 - f) / area + f / (math.pi * (s.contact_radius**2 - s.inner_radius**2)))
         stretch += (below * l + w * l**2 / 2) / (s.young_modulus * area)
         below += w * l
     dofs = model.space.expand(prepared.equilibrium.q)

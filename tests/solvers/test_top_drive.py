@@ -96,14 +96,14 @@ def test_a_speed_controller_holds_the_set_speed_and_its_motor_work_closes_the_bu
 
 def test_the_soft_torque_tuning_matches_the_pipe_impedance_at_the_stick_slip_frequency():
     """The top drive's impedance Z_td(i w) = k_p + k_i / (i w) + i w J_td equals the pipe's characteristic
-    impedance Z = sqrt(k_t rho I_xx) (k_t = kappa_s G I_xx, the model's torsional stiffness) at the first
+    impedance Z = sqrt(k_t rho I_xx) (k_t = G I_xx, St-Venant's torsional stiffness) at the first
     torsional quarter wave w_s: the reflection coefficient (Z_td - Z) / (Z_td + Z) vanishes there and grows
     away from it."""
     scene = scene_with("drive.controller='soft_torque'")
     p = scene.beam_properties
     polar = 2 * p.section.I4
-    impedance = math.sqrt(p.shear_factor * p.shear_modulus * polar * p.density * polar)
-    w_s = 2 * math.pi * math.sqrt(p.shear_factor * p.shear_modulus / p.density) / (4 * p.length)
+    impedance = math.sqrt(p.shear_modulus * polar * p.density * polar)
+    w_s = 2 * math.pi * math.sqrt(p.shear_modulus / p.density) / (4 * p.length)
     k_p, k_i = controller_gains(scene.drive, p)
 
     def reflection(w):
