@@ -50,15 +50,26 @@ def cmd_scene(args) -> int:
 
 def cmd_modal(args) -> int:
     """Modal analysis (62) and reduced-basis selection; writes DIR/modes.json."""
+    from fenics_drill.plots.modal import spectra_figure
     from fenics_drill.studies.modal_report import write_modal_report
 
     scene = load_scene(args.scene, args.overrides)
     report = write_modal_report(scene, args.out, overwrite=args.overwrite)
+    spectra_figure(report, Path(args.out) / "modes.png")
     red = report["reduced_basis"]
     chosen = (f"reduced basis ({scene.reduction.rule}): {red['size']} = {red['counts']}" if red["counts"] else
               f"full order ({scene.reduction.rule}{': ' + red['guard']['full_order']['why'] if 'guard' in red else ''})")
-    print(f"{report['full_dofs']} dofs, {len(report['modes'])} modes with f* <= {scene.modal.f_star_max}, {chosen} "
-          f"[{report['wall_time_s']:.1f} s] -> {Path(args.out) / 'modes.json'}")
+    about = report["linearised_about"]
+    state = "the unloaded string" if about["state"] == "unloaded" else \
+        f"the static state (weight on bit {about['weight_on_bit_N'] / 1e3:.4g} kN)"
+    print(f"{report['full_dofs']} dofs, {len(report['modes'])} free-free modes with f* <= {scene.modal.f_star_max} "
+          f"about {state}, {chosen} [{report['wall_time_s']:.1f} s] -> {Path(args.out) / 'modes.json'}")
+    if report["first_torsional_period_s"]:
+        print(f"drive-held, bit off bottom: first torsional mode {report['first_torsional_frequency_hz']:.4g} Hz "
+              f"(period {report['first_torsional_period_s']:.4g} s)")
+    if report["lateral_critical_speeds_rpm"]:
+        print("lateral critical speeds (order 1, not spinning; `fenics-drill campbell` for the spinning string): "
+              + ", ".join(f"{r:.4g}" for r in report["lateral_critical_speeds_rpm"]) + " rpm")
     return 0
 
 
@@ -246,7 +257,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("scene", help="validate a scene and print it with all defaults")
     _scene_args(p, out=False)
     p.set_defaults(func=cmd_scene)
-    p = sub.add_parser("modal", help="modal analysis (Eq. 62) and reduced basis (Section 6.3): DIR/modes.json")
+    p = sub.add_parser("modal", help="modal analysis (Eq. 62) about the unloaded string or the static state, the spectra "
+                       "of the run's end conditions and the reduced basis (Section 6.3): DIR/modes.json, modes.png")
     _scene_args(p)
     p.set_defaults(func=cmd_modal)
     p = sub.add_parser("static", help="static equilibrium under gravity (Section 6.4): DIR/static.json")

@@ -229,6 +229,11 @@ class Modal:
     f_star_max: float = key(4.0, "upper end of the dimensionless band of analysis B = [0, f*_max], Eq. (95) [-]",
                             lambda x: 1.0 <= x <= 64.0, "in [1, 64] (the band holds the first axial and torsional "
                             "modes, near f* = 0.3-0.5)")
+    state: str = key("auto", "linearised about: 'unloaded' (the stiffness (46)), 'static' (the static state under "
+                     "gravity, the wall and modal.weight_on_bit: its tension and wall springs) or 'auto' (static in a "
+                     "well, unloaded in the straight horizontal hole)", choices=("auto", "unloaded", "static"))
+    weight_on_bit: float = _nonneg("compression at the bit of the static state the modes are linearised about; 0: the "
+                                   "bit off bottom [N]", 0.0)
 
 
 @dataclass(frozen=True)

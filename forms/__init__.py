@@ -9,7 +9,7 @@ Field ordering everywhere is the paper's: ``U = (u, v, w, theta_x, theta_y, thet
 """
 
 from .properties import BeamProperties, SectionConstants, section_constants
-from .linear import mass_form, damping_form, stiffness_form, gravity_form
+from .linear import mass_form, damping_form, stiffness_form, gravity_form, geometric_stiffness_form
 
 FIELD_NAMES = ("u", "v", "w", "theta_x", "theta_y", "theta_z")
 
@@ -21,5 +21,6 @@ __all__ = [
     "damping_form",
     "stiffness_form",
     "gravity_form",
+    "geometric_stiffness_form",
     "FIELD_NAMES",
 ]

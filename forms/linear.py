@@ -1,4 +1,5 @@
-"""Linear operators of the weak equation of motion (43): Eqs. (44), (45), (46), (52).
+"""Linear operators of the weak equation of motion (43): Eqs. (44), (45), (46), (52), and the initial-stress
+stiffness of a prestressed state.
 
 ``U`` and ``psi`` are 6-component UFL objects (trial/coefficient and test
 function of the mixed space) ordered (u, v, w, theta_x, theta_y, theta_z);
@@ -55,6 +56,24 @@ def stiffness_form(p: BeamProperties, psi, U, dx):
     torsion = p.torsional_rigidity * dptx * dtx
     shear = ks * G * s.area * ((psi[4] + dpw) * (U[4] + dw) + (psi[5] - dpv) * (U[5] - dv))
     return (axial + bending + torsion + shear) * dx
+
+
+def axial_force(p: BeamProperties, U0):
+    """N = E A eps of a state U0, with the Green-Lagrange stretch eps = u' + (u'^2 + v'^2 + w'^2) / 2 (the frame's
+    derivatives on a curved axis) [N, tension positive]."""
+    du, dv, dw = axial_derivatives(U0, p.axis)[:3]
+    return p.young_modulus * p.stiffness_section.area * (du + 0.5 * (du**2 + dv**2 + dw**2))
+
+
+def geometric_stiffness_form(p: BeamProperties, psi, U, U0, dx):
+    """The initial-stress stiffness of the axial force N of a state U0 (:func:`axial_force`):
+    int N (psi_v' v' + psi_w' w') dx, the term -(N y')' of the tensioned beam, which the stiffness (46) lacks.
+    K(46) + this is the prestressed string of a linear buckling or prestressed modal analysis: the lateral modes
+    feel the hanging tension and the weight on bit, the axial and torsional ones keep the stiffness (46)."""
+    N = axial_force(p, U0)
+    _, dv, dw = axial_derivatives(U, p.axis)[:3]
+    _, dpv, dpw = axial_derivatives(psi, p.axis)[:3]
+    return N * (dpv * dv + dpw * dw) * dx
 
 
 def gravity_form(p: BeamProperties, psi, dx):

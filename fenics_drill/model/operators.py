@@ -1,4 +1,5 @@
-"""Assembly of the linear operators M, C, K and the gravity load F_G (Eqs. 44-46, 52)."""
+"""Assembly of the linear operators M, C, K and the gravity load F_G (Eqs. 44-46, 52), and of the initial-stress
+stiffness of a prestressed state."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from dolfinx import fem
 from petsc4py import PETSc
 
 from fenics_drill.model.discretization import BeamDiscretization
-from fenics_drill.forms import damping_form, gravity_form, mass_form, stiffness_form
+from fenics_drill.forms import damping_form, geometric_stiffness_form, gravity_form, mass_form, stiffness_form
 
 
 def petsc_to_scipy(A: PETSc.Mat) -> sp.csr_matrix:
@@ -62,17 +63,40 @@ def assemble_linear(disc: BeamDiscretization) -> LinearOperators:
     return LinearOperators(mat(m), mat(c), mat(k), gravity)
 
 
-def assemble_modal_pair(disc: BeamDiscretization, held: tuple = ()) -> tuple[PETSc.Mat, PETSc.Mat]:
+def assemble_geometric_stiffness(disc: BeamDiscretization, displacement: np.ndarray) -> sp.csr_matrix:
+    """The initial-stress stiffness of the axial force of the full-space ``displacement`` (free-free, SciPy CSR;
+    :func:`~fenics_drill.forms.linear.geometric_stiffness_form`)."""
+    state = fem.Function(disc.V)
+    state.x.array[:] = displacement
+    U, psi = ufl.TrialFunction(disc.V), ufl.TestFunction(disc.V)
+    dx = ufl.Measure("dx", domain=disc.mesh)
+    A = fem_petsc.assemble_matrix(fem.form(geometric_stiffness_form(disc.form_properties, psi, U, state, dx)))
+    A.assemble()
+    return petsc_to_scipy(A)
+
+
+def assemble_modal_pair(disc: BeamDiscretization, held: tuple = (),
+                        stiffness: sp.spmatrix | None = None) -> tuple[PETSc.Mat, PETSc.Mat]:
     """K and M for the modal problem (62), support dofs (and the ``held`` (field, end) pairs) as
-    Dirichlet rows.
+    Dirichlet rows; K is the stiffness (46), or ``stiffness`` (SciPy, on every dof: a tangent stiffness about a
+    loaded state).
 
     K gets 1 and M gets 0 on the diagonal of each constrained row/column, so the
     constrained dofs carry infinite eigenvalues that shift-and-invert never finds.
     """
     m, _, k, _ = _forms(disc)
     bcs = disc.support_bcs(held)
-    K = fem_petsc.assemble_matrix(k, bcs=bcs, diag=1.0)
-    K.assemble()
+    if stiffness is None:
+        K = fem_petsc.assemble_matrix(k, bcs=bcs, diag=1.0)
+        K.assemble()
+    else:
+        constrained = np.concatenate([disc.support_dofs, [disc.end_dof(f, end) for f, end in held]]).astype(int)
+        free = np.ones(disc.ndofs)
+        free[constrained] = 0.0
+        keep = sp.diags(free)
+        A = (keep @ sp.csr_matrix(stiffness) @ keep + sp.diags(1.0 - free)).tocsr()
+        A.sort_indices()
+        K = PETSc.Mat().createAIJ(A.shape, csr=(A.indptr, A.indices, A.data), comm=disc.comm)
     M = fem_petsc.assemble_matrix(m, bcs=bcs, diag=0.0)
     M.assemble()
     return K, M

@@ -1,5 +1,5 @@
 """``fenics-drill plot DIR``: the figures of whatever DIR holds - a run, a Monte Carlo study, an
-operating window, a Campbell diagram or a torque-and-drag study.
+operating window, a Campbell diagram, a modal analysis or a torque-and-drag study.
 
 Every plot records what it was drawn from (``figures.json``: the command's status, rows or realisations, and
 the figures), and marks the figures of a run or study that is running, interrupted, failed or killed with a
@@ -48,14 +48,16 @@ def drawn_from(directory: Path) -> dict:
     except (UnreadableFile, OSError):
         summary = {}
     status = summary.get("status", "unknown")
-    for kind, name in (("torque-drag", "torque_drag.json"), ("campbell", "campbell.json"), ("optimize", "optimize.json"), ("mc", "statistics.h5"),
+    for kind, name in (("torque-drag", "torque_drag.json"), ("campbell", "campbell.json"), ("modal", "modes.json"),
+                       ("optimize", "optimize.json"), ("mc", "statistics.h5"),
                        ("run", "timeseries.h5"), ("static", "static_profiles.h5")):
         if (directory / name).exists():
             break
     else:
         said = f" (its command is {status}: {summary.get('message')})" if summary.get("message") else ""
         raise NothingToPlot(f"{directory} holds no timeseries.h5 ('fenics-drill run'), statistics.h5 "
-                            "('fenics-drill mc'), optimize.json ('fenics-drill optimize'), campbell.json "
+                            "('fenics-drill mc'), optimize.json ('fenics-drill optimize'), modes.json ('fenics-drill "
+                            "modal'), campbell.json "
                             "('fenics-drill campbell'), torque_drag.json ('fenics-drill torque-drag') or "
                             f"static_profiles.h5 ('fenics-drill static' on a well){said}")
     state = {"kind": kind, "status": status}
@@ -92,6 +94,10 @@ def _draw(directory: Path, kind: str, gif: bool) -> list[Path]:
         from fenics_drill.plots.campbell import campbell_figure
 
         return [campbell_figure(read_json(directory / "campbell.json"), directory / "campbell.png")]
+    if kind == "modal":
+        from fenics_drill.plots.modal import spectra_figure
+
+        return [spectra_figure(read_json(directory / "modes.json"), directory / "modes.png")]
     if kind == "optimize":
         from fenics_drill.plots.window import optimize_figures
 

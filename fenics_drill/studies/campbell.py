@@ -19,15 +19,12 @@ import numpy as np
 
 from fenics_drill.io.files import write_json
 from fenics_drill.model.discretization import BeamDiscretization
-from fenics_drill.model.drillstring import DrillstringModel
-from fenics_drill.model.forces.axial_tip_load import AxialTipLoad
 from fenics_drill.model.forces.bit_rock import bit_rock_force
 from fenics_drill.model.forces.wall_contact import WallContact
 from fenics_drill.model.operators import assemble_linear
 from fenics_drill.model.rotating_modes import held_space, linearise_about_spin, solve_whirl_modes
-from fenics_drill.model.reduction.spaces import FullSpace
-from fenics_drill.solvers.static import solve_static
 from fenics_drill.studies.lifecycle import command_output
+from fenics_drill.studies.operating_state import operating_state
 
 RPM = 60.0 / (2.0 * math.pi)  # rad/s -> rev/min
 
@@ -43,25 +40,6 @@ def axial_preload(scene) -> float:
         bit = scene.bit_rock
         return -float(bit_rock_force(scene.drive.axial_velocity, bit.limit_force, bit.rate))
     return scene.campbell.axial_force
-
-
-def steady_state(scene, disc: BeamDiscretization, operators, preload: float) -> tuple[np.ndarray, dict]:
-    """The full-space displacement the modes are linearised about, and what it holds."""
-    on_wall = scene.campbell.state == "static"
-    switches = {"gravity": on_wall and scene.model.gravity, "contact": on_wall and scene.model.contact,
-                "bit_rock": False}
-    at_rest = scene.with_changes(model=switches)
-    model = DrillstringModel(at_rest, disc, FullSpace(disc), operators)
-    if preload != 0:
-        model = model.with_added_force(AxialTipLoad(disc, model.space, preload))
-    if not model.forces:
-        return np.zeros(disc.ndofs), {"state": "straight", "newton_iterations": 0}
-    equilibrium = solve_static(model)
-    state = model.space.expand(equilibrium.q)
-    wall = model.force("wall")
-    in_contact = int(wall.evaluate(equilibrium.q, np.zeros_like(equilibrium.q)).in_contact.sum()) if wall else 0
-    return state, {"state": scene.campbell.state, "newton_iterations": equilibrium.iterations,
-                   "vertices_on_the_wall": in_contact}
 
 
 def critical_speeds(speeds: np.ndarray, frequencies: np.ndarray, whirl: list[list[str]], kinds: list[list[str]],
@@ -96,10 +74,11 @@ def campbell_report(scene) -> dict:
     disc = BeamDiscretization.from_scene(scene)
     operators = assemble_linear(disc)
     preload = axial_preload(scene)
-    state, about = steady_state(scene, disc, operators, preload)
+    steady = operating_state(scene, disc, operators, preload, on_wall=scene.campbell.state == "static")
+    about = {k: v for k, v in steady.about.items() if k != "weight_on_bit_N"}
     space = held_space(disc)
-    wall = [WallContact.from_scene(scene, disc, space, operators)] if about.get("vertices_on_the_wall") else []
-    linearisation = linearise_about_spin(disc, operators, scene.model, state, space, wall)
+    wall = [WallContact.from_scene(scene, disc, space, operators)] if steady.on_the_wall else []
+    linearisation = linearise_about_spin(disc, operators, scene.model, steady.displacement, space, wall)
     setup = time.perf_counter() - start
     low, high, n = cfg.rotation_speed
     speeds = np.linspace(low, high, int(n))

@@ -168,13 +168,15 @@ def _modes_of_block(K: PETSc.Mat, M: PETSc.Mat, dofs: np.ndarray, free_dofs: int
 
 
 def solve_modes(disc: BeamDiscretization, f_star_max: float, mass=None, held: tuple = (),
-                safety: float = 1.15, vectors: bool = True) -> ModalBasis:
+                safety: float = 1.15, vectors: bool = True, stiffness=None) -> ModalBasis:
     """All modes with f* = f L / c_L <= ``f_star_max`` (Eq. 95), sorted by frequency; ``mass`` is the
     assembled free-free M (SciPy) used to normalise and classify them (assembled here if not given).
     ``held`` adds (field, end) pairs to the supports: with :data:`~fenics_drill.model.discretization.DRIVE`,
     the modes of the string held by the drive as in a run (axial and torsional quarter waves).
     ``vectors``: keep the eigenvectors (False: frequencies and kinds only, for the full order's spectra; the
     modes of a band that grows with the length cost length^2 in memory, 0.7 GB at 3 km).
+    ``stiffness``: K of (62) on every dof instead of the stiffness (46): the tangent stiffness about a loaded
+    static state (:mod:`fenics_drill.studies.operating_state`), with its geometric stiffness and wall springs.
 
     The problem is solved for each group of fields that K and M couple (:func:`coupled_field_groups`: four
     for the straight string, a third of the cost of one solve of the whole); in each, the number of requested
@@ -184,7 +186,7 @@ def solve_modes(disc: BeamDiscretization, f_star_max: float, mass=None, held: tu
     p = disc.properties
     c_L = p.longitudinal_wave_speed
     f_max = f_star_max * c_L / p.length
-    K, M = assemble_modal_pair(disc, held)
+    K, M = assemble_modal_pair(disc, held, stiffness)
     mass = sp.csr_matrix(assemble_linear(disc).mass if mass is None else mass)
     # The target sits below zero so K - target*M is positive definite despite the rigid modes.
     target = -((2.0 * math.pi * 1e-3 * c_L / p.length) ** 2)

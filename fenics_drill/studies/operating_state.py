@@ -1,0 +1,73 @@
+"""The static state a string's modes are linearised about: the string at rest on the wall under gravity (Section
+6.4), compressed at the bit by a weight on bit, solved in the full order; and its tangent stiffness there.
+
+The state is shared by the critical-speed analysis (``fenics-drill campbell``, which linearises the energies about
+it) and the modal analysis of a string in a well (``fenics-drill modal``).  The modal analysis takes the prestressed
+string: the stiffness (46), the initial-stress stiffness of the state's axial force (the hanging tension and the
+weight on bit: :func:`~fenics_drill.forms.linear.geometric_stiffness_form`), and the wall's normal springs at the
+vertices resting on it (with the pendulum term F_n / r of a preloaded radial spring).  The friction has no memory
+at a static state, so no friction spring joins it: the modes are those of a string free to slide.  The full tangent
+of the Green-Lagrange energy would also stiffen the axial and torsional waves with the strain (a St-Venant-Kirchhoff
+material's, not steel's: +6e-4 to +8e-4 on the frequencies of a 1500 m string hanging in air), so it is not used.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from fenics_drill.model.drillstring import DrillstringModel
+from fenics_drill.model.forces.axial_tip_load import AxialTipLoad
+from fenics_drill.model.forces.wall_contact import WallContact
+from fenics_drill.model.operators import assemble_geometric_stiffness
+from fenics_drill.model.reduction.spaces import FullSpace
+from fenics_drill.solvers.static import solve_static
+
+
+@dataclass
+class OperatingState:
+    """The full-space displacement of the static state, what it holds (``about``: 'state', Newton iterations,
+    vertices on the wall, the weight on bit) and the wall's law at it (None when no vertex rests on the wall)."""
+
+    displacement: np.ndarray
+    about: dict
+    on_the_wall: bool
+
+
+def operating_state(scene, disc, operators, weight_on_bit: float, on_wall: bool) -> OperatingState:
+    """The static state under gravity and the wall (``on_wall``, as ``model.gravity`` and ``model.contact`` allow)
+    with the compression ``weight_on_bit`` [N] at the bit; the straight string when nothing loads it.  The drive
+    holds the top (u and theta_x at x = 0), the bit is free axially (the weight on bit is a load, not a support)."""
+    switches = {"gravity": on_wall and scene.model.gravity, "contact": on_wall and scene.model.contact,
+                "bit_rock": False}
+    at_rest = scene.with_changes(model=switches)
+    model = DrillstringModel(at_rest, disc, FullSpace(disc), operators)
+    if weight_on_bit != 0:
+        model = model.with_added_force(AxialTipLoad(disc, model.space, weight_on_bit))
+    state = "static" if on_wall else "straight"
+    if not model.forces:
+        return OperatingState(np.zeros(disc.ndofs), {"state": state, "newton_iterations": 0,
+                                                     "weight_on_bit_N": weight_on_bit}, False)
+    equilibrium = solve_static(model)
+    displacement = model.space.expand(equilibrium.q)
+    wall = model.force("wall")
+    in_contact = int(wall.evaluate(equilibrium.q, np.zeros_like(equilibrium.q)).in_contact.sum()) if wall else 0
+    return OperatingState(displacement, {"state": state, "newton_iterations": equilibrium.iterations,
+                                         "vertices_on_the_wall": in_contact, "weight_on_bit_N": weight_on_bit},
+                          in_contact > 0)
+
+
+def loaded_stiffness(scene, disc, operators, state: OperatingState) -> sp.csr_matrix:
+    """The stiffness of the prestressed string at ``state`` on every dof of the mixed space (SciPy CSR, free-free):
+    K (46), the initial-stress stiffness of the state's axial force and the wall's normal springs (module doc)."""
+    stiffness = operators.stiffness + assemble_geometric_stiffness(disc, state.displacement)
+    if not state.on_the_wall:
+        return stiffness.tocsr()
+    space = FullSpace(disc)
+    wall = WallContact.from_scene(scene, disc, space, operators)
+    q = space.project(state.displacement)
+    springs = sp.csr_matrix(wall.tangent(wall.evaluate(q, np.zeros_like(q), with_tangent=True), 1.0, 0.0))
+    embed = sp.csr_matrix((np.ones(space.size), (space.free, np.arange(space.size))), shape=(disc.ndofs, space.size))
+    return (stiffness - embed @ springs @ embed.T).tocsr()
