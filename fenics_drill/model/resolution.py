@@ -13,7 +13,10 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from fenics_drill.model.string_sections import string_sections
+import numpy as np
+
+from fenics_drill.model.string_sections import section_at, string_sections
+from fenics_drill.model.well import well_of
 
 #: Fewest displacement nodes (elements x degree) per flexural wavelength at f_max for the band to be carried
 #: within about 10 %.
@@ -26,25 +29,58 @@ def band_frequency(scene) -> float:
     return scene.modal.f_star_max * p.longitudinal_wave_speed / p.length
 
 
-def flexural_wavelength(properties, frequency_hz: float) -> float:
-    """Wavelength [m] of a bending wave of the pipe at ``frequency_hz``: 2 pi / k with k^4 = rho A omega^2 / E I
-    (Euler-Bernoulli; shear shortens it a little at high frequency)."""
+def flexural_wavelength(properties, frequency_hz: float, tension=0.0):
+    """Wavelength [m] of a bending wave of the pipe at ``frequency_hz`` under the axial ``tension`` T [N]: 2 pi / k
+    with E I k^4 + T k^2 = rho A omega^2 (the tensioned Euler-Bernoulli beam; shear shortens it a little at high
+    frequency).  Tension lengthens the wave, compression shortens it."""
     s = properties.section
     omega = 2.0 * math.pi * frequency_hz
-    k = (properties.density * s.area * omega**2 / (properties.young_modulus * s.I4)) ** 0.25
-    return 2.0 * math.pi / k
+    bending, inertia = properties.young_modulus * s.I4 * properties.inertia_stiffness_factor, properties.density * s.area
+    tension = np.asarray(tension, dtype=float)
+    k2 = (np.sqrt(tension**2 + 4.0 * bending * inertia * omega**2) - tension) / (2.0 * bending)
+    return 2.0 * math.pi / np.sqrt(k2)
+
+
+#: Points per element at which :func:`nodes_per_wavelength` reads the hanging tension.
+TENSION_SAMPLES = 2
+
+
+def hanging_tension(scene, md: np.ndarray) -> np.ndarray:
+    """The effective tension [N] at measured depths ``md`` of the string hanging in its well (a string of sections
+    on a survey): the buoyed weight below each point along the axis, less the weight on bit ``modal.weight_on_bit``
+    (Lubinski's effective tension without wall friction).  Zero in the straight horizontal hole."""
+    if not (scene.well.survey or scene.well.md) or not scene.model.gravity:
+        return np.zeros_like(md)
+    sections = string_sections(scene)
+    trajectory = well_of(scene, sections[-1].bottom).trajectory
+    fine = np.linspace(0.0, sections[-1].bottom, max(2001, 4 * scene.beam.elements + 1))
+    weight = np.array([s.buoyed_weight(scene.environment.gravity, scene.fluid.density, scene.inner_fluid_density)
+                       for s in sections])[section_at(sections, fine)]
+    along = weight * np.cos(trajectory.inclination(fine))  # the weight's component down the axis [N/m]
+    below = np.concatenate([np.cumsum((0.5 * (along[1:] + along[:-1]) * np.diff(fine))[::-1])[::-1], [0.0]])
+    return np.interp(md, fine, below) - scene.modal.weight_on_bit
 
 
 def nodes_per_wavelength(scene) -> float:
-    """Displacement nodes of the mesh (elements x degree over the length) per flexural wavelength at f_max, in the
-    section whose wavelength is the shortest."""
+    """Displacement nodes of the mesh (elements x degree over the length) per flexural wavelength at f_max, where
+    it is the shortest: each section's pipe (its homogenised tool joints' bending stiffness included) under the
+    tension it hangs with in a well (:func:`hanging_tension`), or unloaded in the straight horizontal hole."""
     b = scene.beam
-    spacing = scene.string_length / (b.elements * b.element_degree)
+    length = scene.string_length
+    spacing = length / (b.elements * b.element_degree)
     p, f_max = scene.beam_properties, band_frequency(scene)
-    pipes = [replace(p, outer_radius=s.outer_radius, inner_radius=s.inner_radius, young_modulus=s.young_modulus,
-                     density=s.mass_per_length / (math.pi * (s.outer_radius**2 - s.inner_radius**2)))
-             for s in string_sections(scene)] if scene.string.sections else [p]
-    return min(flexural_wavelength(pipe, f_max) for pipe in pipes) / spacing
+    if not scene.string.sections:
+        md = np.linspace(0.0, length, TENSION_SAMPLES * b.elements + 1)
+        return float(np.min(flexural_wavelength(p, f_max, hanging_tension(scene, md)))) / spacing
+    sections = string_sections(scene)
+    shortest = np.inf
+    for s in sections:
+        pipe = replace(p, outer_radius=s.outer_radius, inner_radius=s.inner_radius, young_modulus=s.young_modulus,
+                       density=s.mass_per_length / (math.pi * (s.outer_radius**2 - s.inner_radius**2)),
+                       inertia_stiffness_factor=s.stiffness_factors[1])
+        md = np.linspace(s.top, s.bottom, max(2, math.ceil(TENSION_SAMPLES * b.elements * (s.bottom - s.top) / length)))
+        shortest = min(shortest, float(np.min(flexural_wavelength(pipe, f_max, hanging_tension(scene, md)))))
+    return shortest / spacing
 
 
 def mesh_advice(scene) -> str | None:
