@@ -47,7 +47,9 @@ class RunResult:
 
 
 def modal_analysis(scene: Scene) -> dict:
-    """Modes of the band B (Eq. 62), their kinds and the reduced basis (Section 6.3): modes.json."""
+    """Modes of the band B (Eq. 62) about the state ``modal.state`` chooses (in a well: the static state, its tension
+    and wall springs), their kinds, the spectra of the run's end conditions and the reduced basis (Section 6.3):
+    modes.json."""
     return modal_report(scene)
 
 

@@ -375,9 +375,10 @@ class DrillstringModel:
         return float(u), float(du), float(tx), float(dtx)
 
 
-def build_model(scene) -> DrillstringModel:
-    """Discretize, solve the modal problem, choose the basis and build the model of a scene."""
+def build_model(scene, modal_stiffness=None) -> DrillstringModel:
+    """Discretize, solve the modal problem, choose the basis and build the model of a scene
+    (``modal_stiffness``: :func:`~fenics_drill.model.reduction.spaces.solution_space`'s)."""
     disc = BeamDiscretization.from_scene(scene)
     operators = assemble_linear(disc)
-    space, basis, modes, guard, _ = solution_space(scene, disc, operators)
+    space, basis, modes, guard, _ = solution_space(scene, disc, operators, modal_stiffness)
     return DrillstringModel(scene, disc, space, operators, basis, modes, guard)

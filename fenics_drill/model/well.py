@@ -72,9 +72,10 @@ class Survey:
         return survey
 
     def doglegs(self) -> np.ndarray:
-        """The angle between consecutive stations' tangents [rad]."""
+        """The angle between consecutive stations' tangents [rad]: 2 arcsin(|t2 - t1| / 2), exact to round-off for
+        small angles (arccos of the dot product loses half the digits there: 1.5e-8 rad on a hold)."""
         t = tangent(self.inclination, self.azimuth)
-        return np.arccos(np.clip(np.einsum("ij,ij->i", t[:-1], t[1:]), -1.0, 1.0))
+        return 2.0 * np.arcsin(np.clip(0.5 * np.linalg.norm(t[1:] - t[:-1], axis=1), 0.0, 1.0))
 
 
 def read_survey_csv(path: Path) -> Survey:
@@ -112,7 +113,7 @@ class Trajectory:
         beta = survey.doglegs()
         self.beta = beta
         length = np.diff(self.md)
-        ratio = np.where(beta > 1e-9, np.tan(beta / 2) / np.where(beta > 1e-9, beta / 2, 1.0), 1.0)
+        ratio = np.where(beta > 0, np.tan(beta / 2) / np.where(beta > 0, beta / 2, 1.0), 1.0)
         steps = 0.5 * length[:, None] * ratio[:, None] * (self.t[:-1] + self.t[1:])
         self.stations = np.vstack([np.zeros(3), np.cumsum(steps, axis=0)])
 
@@ -130,7 +131,7 @@ class Trajectory:
         share = np.clip((s - self.md[k]) / (self.md[k + 1] - self.md[k]), 0.0, 1.0)
         beta = self.beta[k]
         t1, t2 = self.t[k], self.t[k + 1]
-        small = beta < 1e-9
+        small = beta == 0  # a hold (the doglegs are exact): the ratios below are well conditioned for any beta > 0
         safe = np.where(small, 1.0, beta)
         a = np.where(small, 1.0 - share, np.sin((1 - share) * safe) / np.sin(safe))
         b = np.where(small, share, np.sin(share * safe) / np.sin(safe))
@@ -145,12 +146,15 @@ class Trajectory:
         length = self.md[k + 1] - self.md[k]
         share = np.clip((s - self.md[k]) / length, 0.0, 1.0)
         t1, t2 = self.t[k], self.t[k + 1]
-        small = beta < 1e-9
+        small = beta == 0
         safe = np.where(small, 1.0, beta)
-        # the slerp integrated from the station: r = L / (beta sin beta) [(cos((1-f) beta) - cos beta) t1 + (1 - cos f beta) t2]
+        # the slerp integrated from the station: r = L / (beta sin beta) [(cos((1-f) beta) - cos beta) t1 + (1 - cos f beta) t2],
+        # the differences of cosines written as products of sines (no cancellation at small beta):
+        # cos((1-f) b) - cos b = 2 sin((1 - f/2) b) sin(f b / 2), 1 - cos(f b) = 2 sin(f b / 2)^2
         denominator = safe * np.sin(safe)
-        c1 = np.where(small, share - share**2 / 2, (np.cos((1 - share) * safe) - np.cos(safe)) / denominator)
-        c2 = np.where(small, share**2 / 2, (1 - np.cos(share * safe)) / denominator)
+        half = np.sin(0.5 * share * safe)
+        c1 = np.where(small, share - share**2 / 2, 2.0 * np.sin((1 - 0.5 * share) * safe) * half / denominator)
+        c2 = np.where(small, share**2 / 2, 2.0 * half**2 / denominator)
         return self.stations[k] + length[:, None] * (c1[:, None] * t1 + c2[:, None] * t2)
 
     def curvature(self, s) -> np.ndarray:
@@ -160,7 +164,8 @@ class Trajectory:
 
     def inclination(self, s) -> np.ndarray:
         """Inclination from the vertical [rad] at measured depths ``s``."""
-        return np.arccos(np.clip(-self.tangents(s)[:, 2], -1.0, 1.0))
+        t = self.tangents(s)
+        return np.arctan2(np.hypot(t[:, 0], t[:, 1]), -t[:, 2])
 
     def bishop_frames(self, s) -> "AxisFrames":
         """The twist-free (Bishop) frame of the axis at measured depths ``s``, and the axis' curvature in it.

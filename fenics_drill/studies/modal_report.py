@@ -23,7 +23,7 @@ from fenics_drill.model.reduction.modes import (ModalBasis, drive_held_modes, fa
                                                 solve_modes, stuck_bit_modes)
 from fenics_drill.model.reduction.spaces import solution_space
 from fenics_drill.studies.lifecycle import command_output
-from fenics_drill.studies.operating_state import loaded_stiffness, operating_state
+from fenics_drill.studies.operating_state import linearised_state, loaded_stiffness, operating_state
 
 #: The end conditions of each spectrum: the (field, end) pairs held besides the supports, and how they read.
 SPECTRA = {
@@ -35,38 +35,29 @@ SPECTRA = {
 CRITICAL_SPEEDS = 3
 
 
-def linearised_state(scene) -> str:
-    """'static' or 'unloaded': what ``modal.state`` chooses for this scene ('auto': static in a well)."""
-    if scene.modal.state != "auto":
-        return scene.modal.state
-    return "static" if (scene.well.survey or scene.well.md) else "unloaded"
-
-
 def _mode_rows(basis: ModalBasis) -> list[dict]:
     return [{"frequency_hz": float(f), "f_star": float(fs), "kind": kind,
              "energy_fractions": dict(zip(FIELD_NAMES, map(float, fr)))}
             for f, fs, kind, fr in zip(basis.frequencies_hz, basis.f_star, basis.kinds, basis.energy_fractions)]
 
 
-def _spectra(scene, disc, operators, free: ModalBasis) -> tuple[dict, dict]:
-    """The three spectra of :data:`SPECTRA` (ModalBasis each, no vectors) and what they are linearised about."""
+def _spectra(scene, disc, operators, free: ModalBasis, loaded) -> dict:
+    """The three spectra of :data:`SPECTRA` (ModalBasis each, no vectors): with the stiffness ``loaded`` (on every
+    dof), or of the unloaded string (None), whose drive-held and stuck-bit spectra come from the free one and the
+    axial and torsional blocks."""
     f_star_max = scene.modal.f_star_max
-    if linearised_state(scene) == "unloaded":
-        held = drive_held_modes(disc, free, f_star_max, operators.mass, operators.stiffness)
-        stuck = stuck_bit_modes(disc, f_star_max, operators.mass, operators.stiffness)
-        others = held.select(np.flatnonzero(np.array(held.kinds) != "torsional"))
-        both = ModalBasis(*(np.concatenate([a, b]) for a, b in ((others.frequencies_hz, stuck.frequencies_hz),
-                                                               (others.f_star, stuck.f_star))),
-                          others.kinds + stuck.kinds, np.concatenate([others.energy_fractions, stuck.energy_fractions]),
-                          None)
-        stuck_spectrum = both.select(np.argsort(both.frequencies_hz, kind="stable"))
-        return ({"free_free": free, "drive_held_bit_off_bottom": held, "drive_held_bit_stuck": stuck_spectrum},
-                {"state": "unloaded"})
-    state = operating_state(scene, disc, operators, scene.modal.weight_on_bit, on_wall=True)
-    stiffness = loaded_stiffness(scene, disc, operators, state)
-    spectra = {name: solve_modes(disc, f_star_max, operators.mass, held=held, vectors=False, stiffness=stiffness)
-               for name, (held, _) in SPECTRA.items()}
-    return spectra, state.about
+    if loaded is not None:
+        return {name: solve_modes(disc, f_star_max, operators.mass, held=held, vectors=False, stiffness=loaded)
+                for name, (held, _) in SPECTRA.items()}
+    held = drive_held_modes(disc, free, f_star_max, operators.mass, operators.stiffness)
+    stuck = stuck_bit_modes(disc, f_star_max, operators.mass, operators.stiffness)
+    others = held.select(np.flatnonzero(np.array(held.kinds) != "torsional"))
+    both = ModalBasis(*(np.concatenate([a, b]) for a, b in ((others.frequencies_hz, stuck.frequencies_hz),
+                                                           (others.f_star, stuck.f_star))),
+                      others.kinds + stuck.kinds, np.concatenate([others.energy_fractions, stuck.energy_fractions]),
+                      None)
+    return {"free_free": free, "drive_held_bit_off_bottom": held,
+            "drive_held_bit_stuck": both.select(np.argsort(both.frequencies_hz, kind="stable"))}
 
 
 def spectra_summary(spectra: dict) -> dict:
@@ -86,25 +77,28 @@ def spectra_summary(spectra: dict) -> dict:
 
 def modal_report(scene) -> dict:
     """full_dofs, every free-free mode (frequency_hz, f_star, kind, energy fractions), the spectra of the run's end
-    conditions about the state ``modal.state`` chooses, the reduced basis (the modes the rule keeps, Table 4, the
-    'auto' rule's stuck-bit torsional modes, and the vectors the guard adds) and the guard's report."""
+    conditions about the state ``modal.state`` chooses, the reduced basis (the modes the rule keeps of the same
+    free-free spectrum, Table 4, the 'auto' rule's stuck-bit torsional modes, and the vectors the guard adds) and
+    the guard's report."""
     disc = BeamDiscretization.from_scene(scene)
     operators = assemble_linear(disc)
-    space, _, basis, guard, stuck = solution_space(scene, disc, operators)
+    loaded, about = None, {"state": "unloaded"}
+    if linearised_state(scene) == "static":
+        state = operating_state(scene, disc, operators, scene.modal.weight_on_bit, on_wall=True)
+        loaded, about = loaded_stiffness(scene, disc, operators, state), state.about
+    space, _, basis, guard, stuck = solution_space(scene, disc, operators,
+                                                   None if loaded is None else lambda *_: loaded)
     kept = [int(i) for i in select_modes(basis, scene)]
-    spectra, about = _spectra(scene, disc, operators, basis)
+    spectra = _spectra(scene, disc, operators, basis, loaded)
     reduced = {
         "rule": scene.reduction.rule,
         "size": len(kept),
         "counts": family_counts(basis.kinds[i] for i in kept),
-        # indices into "modes" where those are the basis's own (the unloaded string's); the frequencies always
-        "mode_indices": kept if about["state"] == "unloaded" else None,
-        "mode_frequencies_hz": [float(basis.frequencies_hz[i]) for i in kept],
+        "mode_indices": kept,  # into "modes": the free-free spectrum the basis is chosen from
         "stuck_bit_modes_hz": [] if stuck is None else [float(f) for f in stuck.frequencies_hz],
         "enrichment_vectors": space.size - len(kept) - (0 if stuck is None else len(stuck)),
         "unknowns": space.size,
         "guard": guard,
-        "modes_of": "the unloaded string (46), enriched with the static state and its responses at rest",
     }
     if scene.reduction.rule == "none":  # full order: the FE space itself, no modal basis
         reduced = {"rule": "none", "size": disc.ndofs, "counts": None, "mode_indices": None}

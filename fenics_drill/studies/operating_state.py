@@ -71,3 +71,24 @@ def loaded_stiffness(scene, disc, operators, state: OperatingState) -> sp.csr_ma
     springs = sp.csr_matrix(wall.tangent(wall.evaluate(q, np.zeros_like(q), with_tangent=True), 1.0, 0.0))
     embed = sp.csr_matrix((np.ones(space.size), (space.free, np.arange(space.size))), shape=(disc.ndofs, space.size))
     return (stiffness - embed @ springs @ embed.T).tocsr()
+
+
+def linearised_state(scene) -> str:
+    """'static' or 'unloaded': what ``modal.state`` chooses for this scene ('auto': static in a well)."""
+    if scene.modal.state != "auto":
+        return scene.modal.state
+    return "static" if (scene.well.survey or scene.well.md) else "unloaded"
+
+
+def prestressed_modes(scene):
+    """What the reduced basis's modes are solved with: None (the stiffness (46)) for an unloaded
+    ``modal.state``, else ``(disc, operators) -> K`` of the string prestressed by its static state
+    (:func:`loaded_stiffness` about :func:`operating_state` with ``modal.weight_on_bit``)."""
+    if linearised_state(scene) == "unloaded":
+        return None
+
+    def stiffness(disc, operators):
+        state = operating_state(scene, disc, operators, scene.modal.weight_on_bit, on_wall=True)
+        return loaded_stiffness(scene, disc, operators, state)
+
+    return stiffness

@@ -28,6 +28,7 @@ from fenics_drill.solvers.static import StaticEquilibrium, StaticFailure, solve_
 from fenics_drill.solvers.step_control import StepTooSmall
 from fenics_drill.solvers.time_loop import Simulation
 from fenics_drill.studies.lifecycle import uninterrupted
+from fenics_drill.studies.operating_state import prestressed_modes
 
 #: Time histories kept per realisation (Figs. 29, 31, 33).
 HISTORIES = ("bit_displacement", "bit_velocity", "bit_rotation", "bit_angular_velocity", "section_w",
@@ -57,7 +58,7 @@ def prepare(scene, dynamics: bool = True, stage=lambda name: None) -> PreparedSc
     (:func:`_with_element_sample`).  ``stage(name)`` is told each part as it starts (a progress report)."""
     clock = time.perf_counter()
     stage("mesh, operators, modes and the reduced basis")
-    model = build_model(scene)
+    model = build_model(scene, prestressed_modes(scene))
     initial = None
     if isinstance(model.space, ModalSpace) and scene.reduction.enrich and scene.model.gravity:
         stage("the static state in the full order, and the responses at rest")

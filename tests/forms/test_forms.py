@@ -77,6 +77,38 @@ def test_linearisation_about_rest_is_M_C_K(disc):
     assert gyro.norm() == 0.0
 
 
+@pytest.mark.parametrize("variant", ["printed torsion", "tool joints"])
+def test_stiffness_46_is_the_energys_tangent_in_each_torsion_and_with_homogenised_tool_joints(variant):
+    """The strain energy's tangent at rest equals the stiffness (46) with the paper's torsion kappa_s G J
+    (``model.torsion = 'printed'``) and on a string whose cells carry homogenised tool joints (the stiffness
+    moments A, I4, I6 scaled per cell), to round-off; and (46)'s torsion is G J (St-Venant) or kappa_s G J."""
+    if variant == "printed torsion":
+        scene = scene_with("beam.length=3", "beam.elements=6", "model.torsion='printed'")
+    else:
+        joint = ('{length = 3.0, outer_radius = 0.0635, inner_radius = 0.0543, tool_joint_outer_radius = 0.0841, '
+                 'tool_joint_inner_radius = 0.0413, tool_joint_length = 0.5, tool_joint_spacing = 9.4}')
+        scene = scene_with("beam.elements=6", f"string.sections=[{joint}]", "well.md=[0.0, 3.0]",
+                           "well.inclination=[90.0, 90.0]", "well.azimuth=[0.0, 0.0]")
+    disc = BeamDiscretization.from_scene(scene)
+    p, dx = disc.form_properties, dx_of(disc)
+    U = fem.Function(disc.V)
+    psi, dU = ufl.TestFunction(disc.V), ufl.TrialFunction(disc.V)
+    Ad = matrix(ufl.derivative(elastic_force(p, psi, U, dx), U, dU))
+    Ap = matrix(stiffness_form(p, psi, dU, dx))
+    x = Ad.createVecRight()
+    x.array[:] = np.random.default_rng(1).standard_normal(disc.ndofs)
+    yd, yp = Ad.createVecLeft(), Ap.createVecLeft()
+    Ad.mult(x, yd)
+    Ap.mult(x, yp)
+    assert np.linalg.norm(yd.array - yp.array) <= 1e-12 * np.linalg.norm(yp.array)
+    numbers = disc.properties
+    expected = (numbers.shear_factor if variant == "printed torsion" else numbers.inertia_stiffness_factor) * \
+        numbers.shear_modulus * 2 * numbers.section.I4
+    assert numbers.torsional_rigidity == pytest.approx(expected, rel=1e-14)
+    if variant == "tool joints":
+        assert numbers.inertia_stiffness_factor > 1.05  # the joints stiffen the pipe: the case tests something
+
+
 @pytest.mark.parametrize("seed", [3, 11])
 def test_printed_operators_match_energy_or_are_recorded_errata(disc, seed):
     """F_KE (48) equals the energy derivation term by term; every Gamma that does not is in

@@ -177,3 +177,23 @@ def test_lateral_modes_of_a_bha_under_weight_on_bit_are_the_compressed_beams():
     np.testing.assert_allclose(fe[:5], exact, rtol=1e-2)
     hanging = tensioned_beam_frequencies(120.0, E * c.I4, m, m * 9.81, 0.0, 5)
     assert np.all(exact < hanging)
+
+
+def test_the_reduced_basis_in_a_well_is_chosen_from_the_prestressed_modes():
+    """A reduced model of the 500 m hanging string (the paper's friction laws, so the 'count' rule keeps a modal
+    basis): its basis's flexural modes are the prestressed string's, the tensioned beam's within 1 % (as above),
+    and the modal report's basis indexes the same free-free spectrum."""
+    from fenics_drill.model.drillstring import build_model
+    from fenics_drill.studies.operating_state import prestressed_modes
+
+    scene = vertical_string([dict(PIPE, length=500.0)], 250, "contact.friction_model='paper'",
+                            "reduction.rule='count'", "reduction.flexural=6", "reduction.torsional=2",
+                            "reduction.axial=2", "modal.f_star_max=1.0")
+    model = build_model(scene, prestressed_modes(scene))
+    flexural = model.basis.frequencies_hz[np.array(model.basis.kinds) == "flexural"][::2]
+    c = section_constants(PIPE["outer_radius"], PIPE["inner_radius"])
+    m = RHO * c.area
+    np.testing.assert_allclose(flexural, tensioned_beam_frequencies(500.0, E * c.I4, m, m * 9.81, 0.0, 3), rtol=1e-2)
+    report = modal_report(scene)
+    kept = [report["modes"][i]["frequency_hz"] for i in report["reduced_basis"]["mode_indices"]]
+    np.testing.assert_allclose(sorted(kept), np.sort(model.basis.frequencies_hz), rtol=1e-9)

@@ -317,11 +317,13 @@ class BasisError(ValueError):
     """A reduced basis that misses a load beyond the guard's tolerance, with enrichment off."""
 
 
-def solution_space(scene, disc: BeamDiscretization, operators: LinearOperators):
+def solution_space(scene, disc: BeamDiscretization, operators: LinearOperators, modal_stiffness=None):
     """(space, kept modes, all modes, guard report, stuck-bit modes): the modal basis of the scene's
     reduction rule (Section 6.3), with the 'auto' rule's torsional modes of a stuck bit (None otherwise),
     checked and enriched by the guard (:mod:`fenics_drill.model.reduction.enrichment`), or the full space for
-    'none'; all modes of the band B (for spectra) either way, without their vectors for the full space."""
+    'none'; all modes of the band B (for spectra) either way, without their vectors for the full space.
+    ``modal_stiffness(disc, operators)``, if given, is the K of (62) the basis's modes are solved with (a string
+    prestressed by its static state in a well); it is called only for a modal basis."""
     if scene.reduction.rule == "none":
         return FullSpace(disc), None, solve_modes(disc, scene.modal.f_star_max, operators.mass, vectors=False), {}, \
             None
@@ -331,7 +333,8 @@ def solution_space(scene, disc: BeamDiscretization, operators: LinearOperators):
                     {"full_order": {"chosen": True, "why": why}}, None)
         raise BasisError(f"reduction.rule = '{scene.reduction.rule}' is not admissible here: {why}; use "
                          "reduction.rule = 'auto' or 'none' (the full order), or contact.friction_model = 'paper'")
-    modes = solve_modes(disc, scene.modal.f_star_max, operators.mass)
+    stiffness = None if modal_stiffness is None else modal_stiffness(disc, operators)
+    modes = solve_modes(disc, scene.modal.f_star_max, operators.mass, stiffness=stiffness)
     basis = modes.select(select_modes(modes, scene))
     vectors, stuck = basis.vectors, None
     if scene.reduction.rule == "auto" and scene.model.bit_rock:
