@@ -207,9 +207,8 @@ class Model:
                           choices=("objective", "printed"))
     angular_velocity: str = key("consistent", "angular velocity in the kinetic energy (24): 'consistent' or "
                                 "'printed' (13)", choices=("consistent", "printed"))
-    torsion: str = key("st_venant", "torsional stiffness: 'st_venant' (G J of a round tube) or 'printed' (the "
-                       "paper's kappa_s G J, which Table 4's mode counts use; docs/errata.md)",
-                       choices=("st_venant", "printed"))
+    torsion: str = key("st_venant", "torsional stiffness: 'st_venant' (G J) or 'printed' (kappa_s G J, Table 4's; "
+                       "docs/errata.md)", choices=("st_venant", "printed"))
 
 
 def _positions(x) -> bool:
@@ -229,11 +228,9 @@ class Modal:
     f_star_max: float = key(4.0, "upper end of the dimensionless band of analysis B = [0, f*_max], Eq. (95) [-]",
                             lambda x: 1.0 <= x <= 64.0, "in [1, 64] (the band holds the first axial and torsional "
                             "modes, near f* = 0.3-0.5)")
-    state: str = key("auto", "linearised about: 'unloaded' (the stiffness (46)), 'static' (the static state under "
-                     "gravity, the wall and modal.weight_on_bit: its tension and wall springs) or 'auto' (static in a "
-                     "well, unloaded in the straight horizontal hole)", choices=("auto", "unloaded", "static"))
-    weight_on_bit: float = _nonneg("compression at the bit of the static state the modes are linearised about; 0: the "
-                                   "bit off bottom [N]", 0.0)
+    state: str = key("auto", "modes about: 'unloaded', 'static' (tension, wall springs) or 'auto' (static in a well)",
+                     choices=("auto", "unloaded", "static"))
+    weight_on_bit: float = _nonneg("compression at the bit of that static state; 0: off bottom [N]", 0.0)
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,8 @@ from fenics_drill.plots.common import plt, save_figure
 LABELS = {"free_free": "free-free", "drive_held_bit_off_bottom": "drive-held,\nbit off bottom",
           "drive_held_bit_stuck": "drive-held,\nbit stuck"}
 COLOURS = {"flexural": "tab:blue", "torsional": "tab:red", "axial": "tab:green", "rigid": "tab:gray"}
+#: Each kind on its own line within a spectrum's row, so that no kind hides another.
+OFFSETS = {"flexural": 0.0, "torsional": -0.22, "axial": 0.22, "rigid": 0.0}
 
 
 def spectra_figure(report: dict, path: Path) -> Path:
@@ -21,7 +23,7 @@ def spectra_figure(report: dict, path: Path) -> Path:
         for kind, colour in COLOURS.items():
             f = [m["frequency_hz"] for m in spectrum["modes"] if m["kind"] == kind and m["frequency_hz"] > 0]
             if f:
-                ax.scatter(f, [row] * len(f), marker="|", s=300, color=colour,
+                ax.scatter(f, [row + OFFSETS[kind]] * len(f), marker="|", s=150, color=colour,
                            label=kind if row == 0 or kind not in ax.get_legend_handles_labels()[1] else None)
     ax.set_yticks(range(len(spectra)), [LABELS.get(name, name) for name in spectra])
     ax.set_ylim(-0.6, len(spectra) - 0.4)

