@@ -69,6 +69,16 @@ def test_run_modal_and_campbell_work_on_a_well(well_scene, tmp_path):
     assert abs(run["energy"]["balance_error"]) < 1e-3
     assert main(["modal", str(well_scene), "--out", str(tmp_path / "modal")]) == 0
     assert summary(tmp_path / "modal")["status"] in ("finished", "suspect")
+    # the modes about the static state in the well, the three spectra labelled, and their figure
+    modes = json.loads((tmp_path / "modal" / "modes.json").read_text())
+    assert modes["linearised_about"]["state"] == "static"
+    assert set(modes["spectra"]) == {"free_free", "drive_held_bit_off_bottom", "drive_held_bit_stuck"}
+    assert modes["spectra"]["drive_held_bit_stuck"]["held"] == ["u(0)", "theta_x(0)", "theta_x(L)"]
+    torsional = [m["frequency_hz"] for m in modes["spectra"]["drive_held_bit_off_bottom"]["modes"]
+                 if m["kind"] == "torsional"]
+    assert modes["first_torsional_period_s"] == pytest.approx(1 / torsional[0], rel=1e-12)
+    assert len(modes["lateral_critical_speeds_rpm"]) == 3
+    assert (tmp_path / "modal" / "modes.png").stat().st_size > 0
     assert main(["campbell", str(well_scene), "--set", "campbell.rotation_speed=[0.0, 6.0, 3]",
                  "--out", str(tmp_path / "campbell")]) == 0
     assert summary(tmp_path / "campbell")["status"] in ("finished", "suspect")
