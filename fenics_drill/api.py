@@ -11,19 +11,23 @@
     td = fd.torque_drag(fd.load_scene("demos/scenes/well_vbh.toml"))  # td.report (dict), td.profiles (xarray)
 
 Every call takes a :class:`~fenics_drill.scene.Scene`; change one with
-``scene.with_changes(drive={"rotation_speed": 5.0})``.  The command line does the same
-through :mod:`fenics_drill.cli`.
+``scene.with_changes(drive={"rotation_speed": 5.0})``.  Each call checks its scene again as the command line checks
+a scene file (one changed with ``dataclasses.replace`` included) and refuses it with the same one-line
+:class:`~fenics_drill.scene.SceneError`; an output directory's refusal names the Python arguments
+(``overwrite=True``, ``resume=True``).  The command line does the same through :mod:`fenics_drill.cli`.
 """
 
 from __future__ import annotations
 
+import functools
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+from fenics_drill.io.output_directory import OutputError
 from fenics_drill.io.timeseries import open_dataset
 from fenics_drill.plots.directory import plot_directory
-from fenics_drill.scene import Scene
+from fenics_drill.scene import Scene, checked
 from fenics_drill.studies.campbell import campbell_report, write_campbell
 from fenics_drill.studies.modal_report import modal_report
 from fenics_drill.studies.monte_carlo import monte_carlo as _monte_carlo
@@ -46,6 +50,32 @@ class RunResult:
         return open_dataset(self.directory / "timeseries.h5")
 
 
+#: The command line's words in an output directory's message, and the Python arguments they stand for.
+PYTHON_WORDS = (("add --overwrite", "pass overwrite=True"), ("with --overwrite", "with overwrite=True"),
+                ("--resume", "resume=True"), ("--out ", "out="))
+
+
+def python_phrasing(message: str) -> str:
+    """An output directory's message with the Python arguments in place of the command line's options."""
+    for words, argument in PYTHON_WORDS:
+        message = message.replace(words, argument)
+    return message
+
+
+def _entry(function):
+    """An API call: its scene checked again (:func:`~fenics_drill.scene.checked`), an output directory's refusal in
+    the Python arguments' words."""
+    @functools.wraps(function)
+    def call(scene, *args, **kwargs):
+        scene = checked(scene)
+        try:
+            return function(scene, *args, **kwargs)
+        except OutputError as err:
+            raise OutputError(python_phrasing(str(err))) from None
+    return call
+
+
+@_entry
 def modal_analysis(scene: Scene) -> dict:
     """Modes of the band B (Eq. 62) about the state ``modal.state`` chooses (in a well: the static state, its tension
     and wall springs), their kinds, the spectra of the run's end conditions and the reduced basis (Section 6.3):
@@ -53,6 +83,7 @@ def modal_analysis(scene: Scene) -> dict:
     return modal_report(scene)
 
 
+@_entry
 def static_state(scene: Scene, out: str | Path | None = None, overwrite: bool = False) -> dict:
     """Static equilibrium under gravity with wall contact (Section 6.4): static.json; with ``out`` also
     static.xdmf there."""
@@ -61,6 +92,7 @@ def static_state(scene: Scene, out: str | Path | None = None, overwrite: bool = 
     return prepare(scene, dynamics=False).static
 
 
+@_entry
 def run(scene: Scene, out: str | Path | None = None, progress: bool = False, overwrite: bool = False) -> RunResult:
     """Static equilibrium, then the drilling dynamics to ``time.t_end`` into ``out`` (a new temporary
     directory if None; an earlier run there is replaced only with ``overwrite``)."""
@@ -68,18 +100,21 @@ def run(scene: Scene, out: str | Path | None = None, progress: bool = False, ove
     return RunResult(directory, run_scene(scene, directory, progress=progress, overwrite=overwrite))
 
 
+@_entry
 def monte_carlo(scene: Scene, samples: int, out: str | Path, resume: bool = False, progress: bool = False,
                 overwrite: bool = False) -> dict:
     """Monte Carlo over the random bit-rock laws (Section 6.11): the summary of ``out``/summary.json."""
     return _monte_carlo(scene, samples, out, resume=resume, progress=progress, overwrite=overwrite)
 
 
+@_entry
 def operating_window(scene: Scene, out: str | Path, resume: bool = False, progress: bool = False,
                      overwrite: bool = False) -> dict:
     """The operating window of the scene's [optimize] section (Sections 6.9-6.12): optimize.json."""
     return run_optimize(scene, out, resume=resume, progress=progress, overwrite=overwrite)
 
 
+@_entry
 def campbell(scene: Scene, out: str | Path | None = None, overwrite: bool = False) -> dict:
     """Critical speeds: the modes of the string spinning over ``campbell.rotation_speed`` (campbell.json);
     with ``out`` also written there (draw it with :func:`plot`)."""
@@ -97,6 +132,7 @@ class TorqueDragResult:
     profiles: object
 
 
+@_entry
 def torque_drag(scene: Scene, out: str | Path | None = None, overwrite: bool = False) -> TorqueDragResult:
     """Soft-string torque and drag along the scene's well for each of ``torque_drag.operations``; with ``out``
     also written there (torque_drag.json, torque_drag.h5, well.vtu; draw it with :func:`plot`)."""

@@ -21,6 +21,15 @@ from fenics_drill.scene import SceneError, load_scene, section_keys
 
 #: Commands run in a supervised worker process (single-process commands that can run long).
 SUPERVISED = ("run", "static", "modal", "campbell")
+#: Commands that run on one process: under ``mpiexec -n N`` the first rank runs them and the others end at once.
+SINGLE_PROCESS = ("scene", "modal", "static", "campbell", "plot", "forms", "torque-drag")
+
+
+def _output_directory(text: str) -> str:
+    """``--out``: a directory name, not an empty string (which would write into the current directory)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty --out names no directory: give one, e.g. --out out/run1")
+    return text
 
 
 def _scene_args(parser: argparse.ArgumentParser, out: bool = True) -> None:
@@ -30,15 +39,22 @@ def _scene_args(parser: argparse.ArgumentParser, out: bool = True) -> None:
         help="override one scene key; the value is read as TOML (repeatable)",
     )
     if out:
-        parser.add_argument("--out", default="out", help="output directory (created if missing; it must be new "
+        parser.add_argument("--out", default="out", type=_output_directory,
+                            help="output directory (created if missing; it must be new "
                             "or empty, or hold this command's earlier output with --overwrite)")
         parser.add_argument("--overwrite", action="store_true",
                             help="replace this command's earlier output in --out (and nothing else there)")
 
 
 def cmd_scene(args) -> int:
-    """Print the validated scene with every default filled in, as TOML."""
+    """Print the validated scene with every default filled in, as TOML; a well's survey and sections are read and
+    related to the string as every command does (a missing or unsorted survey file is refused here too)."""
     scene = load_scene(args.scene, args.overrides)
+    if scene.well.survey or scene.well.md or scene.string.sections:
+        from fenics_drill.model.string_sections import string_sections
+        from fenics_drill.model.well import well_of
+
+        well_of(scene, string_sections(scene)[-1].bottom)
     for section, entries in scene.to_dict().items():
         print(f"[{section}]")
         keys = section_keys(section)
@@ -419,6 +435,14 @@ def _main(argv: list[str] | None) -> int:
     sys.unraisablehook, sys.excepthook = _quiet_about_full_disks, _quiet_excepthook
     parser = build_parser()
     args = parser.parse_args(argv)
+    if args.command in SINGLE_PROCESS and _under_mpiexec():
+        from mpi4py import MPI
+
+        if MPI.COMM_WORLD.size > 1:
+            if MPI.COMM_WORLD.rank > 0:
+                return 0  # the first rank runs the command; this one has nothing to do
+            _say(f"fenics-drill: '{args.command}' runs on one process: rank 0 runs it, the other "
+                 f"{MPI.COMM_WORLD.size - 1} end")
     if argv is None and args.command in SUPERVISED and not _under_mpiexec():
         from fenics_drill import supervisor
 

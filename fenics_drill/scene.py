@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import re
 import stat
 import tomllib
@@ -175,6 +176,8 @@ class Time:
                                 lambda x: 0 < x <= 1, "in (0, 1]")
     max_step_cuts: int = key(12, "the smallest step is dt / 2^max_step_cuts; a run needing less stops [-]",
                              lambda n: 0 <= n <= 40, "an integer in [0, 40]")
+    max_steps: float = key(1e7, "most steps a run may need at its largest step (t_end / step) before it is refused [-]",
+                           lambda x: x >= 1, ">= 1")
 
 
 @dataclass(frozen=True)
@@ -350,6 +353,12 @@ SECTION_KEYS = {
 }
 
 
+#: The material keys of a string section take the admissible values of their [beam] defaults.
+SECTION_RANGES = {name: (Beam.__dataclass_fields__[name].metadata["check"],
+                         Beam.__dataclass_fields__[name].metadata["admissible"])
+                  for name in ("density", "young_modulus", "poisson_ratio")}
+
+
 def _string_sections(sections) -> bool:
     """Each section a table of SECTION_KEYS with positive lengths and radii; raises SceneError naming the section
     and the key."""
@@ -369,6 +378,8 @@ def _string_sections(sections) -> bool:
                 continue
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
                 raise SceneError(f"{where}.{name} = {value!r} is not admissible: must be a number >= 0")
+            if name in SECTION_RANGES and not SECTION_RANGES[name][0](value):
+                raise SceneError(f"{where}.{name} = {value!r} is not admissible: must be {SECTION_RANGES[name][1]}")
         if section["length"] <= 0 or section["outer_radius"] <= 0:
             raise SceneError(f"{where}: length and outer_radius must be > 0")
         if section["inner_radius"] >= section["outer_radius"]:
@@ -463,6 +474,9 @@ class Scene:
         """A new validated scene with some keys changed: ``scene.with_changes(drive={"rotation_speed": 5.0})``."""
         raw = self.to_dict()
         for section, entries in sections.items():
+            if not isinstance(entries, dict):
+                raise SceneError(f"with_changes({section}={entries!r}): give the keys of [{section}] as a dict, e.g. "
+                                 f"with_changes({section}={{'key': value}})")
             raw.setdefault(section, {}).update(entries)
         return validate(raw)
 
@@ -579,12 +593,15 @@ def _check_relations(scene: Scene) -> Scene:
     if beam.length < 10.0 * beam.outer_radius:
         raise SceneError(f"beam.length = {beam.length!r} is not admissible: must be >= 10 beam.outer_radius = "
                          f"{10.0 * beam.outer_radius:g} m (a beam model needs a slender string)")
+    length = scene.string_length
     if scene.output.section == -1.0:
-        scene = dataclasses.replace(scene, output=dataclasses.replace(scene.output, section=0.5 * beam.length))
-    if scene.output.section > beam.length:
+        scene = dataclasses.replace(scene, output=dataclasses.replace(scene.output, section=0.5 * length))
+    if scene.output.section > length:
+        what = "the string's length" if scene.string.sections else "beam.length"
         raise SceneError(f"output.section = {scene.output.section!r} is not admissible: "
-                         f"must be in [0, beam.length = {beam.length!r}]")
+                         f"must be in [0, {what} = {length!r}]")
     _check_stabilisers(scene)
+    _check_well_keys(scene)
     contact = scene.contact
     if contact.friction_model == "coulomb":
         for name in ("axial_friction_law", "friction_torque_law"):
@@ -631,16 +648,36 @@ def check_history_grid(scene: Scene) -> None:
                          f"most {MAX_GRID_POINTS:g}); use an interval >= {scene.time.t_end / MAX_GRID_POINTS:.3g} s")
 
 
+#: The heaviest drilling fluid admitted [kg/m^3]: above the densest muds and brines (about 2.6 SG).
+MAX_FLUID_DENSITY = 3000.0
+
+
+def _check_well_keys(scene: Scene) -> None:
+    """The well's inline stations come as three lists with the depths; the fluids are fluids a string sinks in."""
+    well = scene.well
+    if (well.inclination or well.azimuth) and not well.md:
+        raise SceneError("well.inclination and well.azimuth are not admissible without well.md: give the stations' "
+                         "measured depths too (or a survey file in well.survey)")
+    fluid = scene.fluid
+    for name, value in (("fluid.density", fluid.density), ("fluid.inner_density", scene.inner_fluid_density)):
+        if value > MAX_FLUID_DENSITY:
+            raise SceneError(f"{name} = {value!r} is not admissible: must be <= {MAX_FLUID_DENSITY:g} kg/m^3 (the "
+                             "densest muds are about 2600 kg/m^3, 21.7 ppg)")
+    if not scene.torque_drag.operations:
+        raise SceneError("torque_drag.operations = [] is not admissible: name at least one operation")
+
+
 def _check_stabilisers(scene: Scene) -> None:
     """Each stabiliser inside the string, on a vertex of its own that no end support holds (a stabiliser holds the
     vertex nearest its position: one that snaps onto a held end, or onto another's vertex, would do nothing)."""
     beam, positions = scene.beam, list(scene.supports.stabilisers)
-    h = beam.length / beam.elements
+    length, what = scene.string_length, ("the string's length" if scene.string.sections else "beam.length")
+    h = length / beam.elements
     taken = {}
     for x in positions:
-        if not 0 < x < beam.length:
+        if not 0 < x < length:
             raise SceneError(f"supports.stabilisers = {positions!r} is not admissible: every position must be in "
-                             f"(0, beam.length = {beam.length!r})")
+                             f"(0, {what} = {length!r})")
         vertex = round(x / h)
         if vertex in (0, beam.elements):
             raise SceneError(f"supports.stabilisers: x = {x!r} m is not admissible: it snaps onto the end vertex at "
@@ -671,6 +708,21 @@ def validate(raw: dict[str, Any]) -> Scene:
     return _check_relations(Scene(**sections))
 
 
+def checked(scene) -> Scene:
+    """``scene`` checked again as a scene file would be: one changed with ``dataclasses.replace`` (or built by
+    hand) meets the same one-line refusals as the command line's."""
+    if not isinstance(scene, Scene):
+        raise SceneError(f"expected a Scene (fenics_drill.load_scene(...)), got {type(scene).__name__}")
+    raw = {}
+    for f in dataclasses.fields(scene):
+        section = getattr(scene, f.name)
+        if not isinstance(section, SECTIONS[f.name]):
+            raise SceneError(f"scene.{f.name} = {section!r} is not admissible: it must be the [{f.name}] section "
+                             f"({SECTIONS[f.name].__name__}); change keys with scene.with_changes({f.name}={{...}})")
+        raw[f.name] = dataclasses.asdict(section)
+    return validate(raw)
+
+
 def parse_override(text: str) -> tuple[str, str, Any]:
     """Parse ``section.key=value``; the value is read as TOML (bare words as strings)."""
     if "=" not in text:
@@ -686,28 +738,39 @@ def parse_override(text: str) -> tuple[str, str, Any]:
     return parts[0], parts[1], value
 
 
+def read_regular_file(path: Path, what: str, limit: int, kind: str) -> bytes:
+    """The bytes of ``path``, a regular file of at most ``limit`` bytes, or a SceneError naming ``what`` (e.g.
+    "scene file") and the file: a directory, a device, a pipe or a socket (which could block, or never end), a
+    missing, unreadable or larger file.  ``kind`` says what the file should be ("a TOML file")."""
+    name = repr(str(path))
+    if path.is_dir():
+        raise SceneError(f"{what} {name} is a directory, not {kind}")
+    if not path.exists():
+        raise SceneError(f"{what} {name} does not exist")
+    try:
+        # O_NONBLOCK: opening a pipe must not wait for a writer; the check is on what was opened
+        descriptor = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+        with os.fdopen(descriptor, "rb") as f:
+            if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
+                raise SceneError(f"{what} {name} is not a regular file (a device, a pipe or a socket); it must be "
+                                 f"{kind}")
+            data = f.read(limit + 1)
+    except OSError as err:
+        raise SceneError(f"{what} {name} cannot be read: {err.strerror}") from err
+    if len(data) > limit:
+        raise SceneError(f"{what} {name} is larger than {limit / 1e6:g} MB; it must be {kind}")
+    return data
+
+
 def _read_toml(path: Path) -> dict[str, Any]:
     """The TOML document of a scene file, or a SceneError that names the file and says what is wrong."""
     name = repr(str(path))
-    if path.is_dir():
-        raise SceneError(f"scene file {name} is a directory, not a TOML file")
-    if not path.exists():
-        raise SceneError(f"scene file {name} does not exist")
+    data = read_regular_file(path, "scene file", MAX_SCENE_BYTES, "a TOML file of a few kB")
+    if not data.strip():
+        raise SceneError(f"scene file {name} is empty; give the keys to change, or leave SCENE out to run the "
+                         "paper's nominal scene")
     try:
-        if not stat.S_ISREG(path.stat().st_mode):
-            raise SceneError(f"scene file {name} is not a regular file (a device, a pipe or a socket); a scene is a "
-                             "TOML file")
-        with open(path, "rb") as f:
-            data = f.read(MAX_SCENE_BYTES + 1)
-        if len(data) > MAX_SCENE_BYTES:
-            raise SceneError(f"scene file {name} is larger than {MAX_SCENE_BYTES / 1e6:g} MB: a scene is a few kB of "
-                             "TOML")
-        if not data.strip():
-            raise SceneError(f"scene file {name} is empty; give the keys to change, or leave SCENE out to run the "
-                             "paper's nominal scene")
         text = data.decode("utf-8")
-    except OSError as err:
-        raise SceneError(f"scene file {name} cannot be read: {err.strerror}") from err
     except UnicodeDecodeError as err:
         raise SceneError(f"scene file {name} is not UTF-8 text (a binary or UTF-16 file?); a scene is a TOML "
                          f"file in UTF-8: {err.reason} at byte {err.start}") from err
@@ -719,6 +782,16 @@ def _read_toml(path: Path) -> dict[str, Any]:
 
 def load_scene(path: str | Path | None = None, overrides: list[str] | tuple[str, ...] = ()) -> Scene:
     """Read a scene file (or the defaults when ``path`` is None), apply overrides, validate."""
+    if isinstance(overrides, str) or not isinstance(overrides, (list, tuple)):
+        raise SceneError(f"overrides = {overrides!r} is not admissible: give a list of 'section.key=value' strings, "
+                         f"e.g. [{overrides!r}]" if isinstance(overrides, str) else
+                         f"overrides = {overrides!r} is not admissible: give a list of 'section.key=value' strings")
+    for text in overrides:
+        if not isinstance(text, str):
+            raise SceneError(f"override {text!r} is not admissible: each override is a 'section.key=value' string")
+    if path is not None and not isinstance(path, (str, Path)):
+        raise SceneError(f"scene file {path!r} is not admissible: give a path (str or pathlib.Path), or None for the "
+                         "paper's nominal scene")
     raw: dict[str, Any] = {}
     if path is not None:
         raw = _read_toml(Path(path))

@@ -4,11 +4,17 @@
   (``run``, ``static``, ``modal``, ``mc``, ``optimize``) from the moment it starts.  A
   command never writes into another command's directory.
 * A directory that already holds the output of the same command is refused unless the
-  user says ``--overwrite`` (then every file that command owns is removed first, and
+  user says ``--overwrite`` (then every file that command wrote is removed first, and
   nothing else) or, for a study, ``--resume`` (continue it).
+* What a command wrote is known from a record, ``.fenics-drill-files.json``: the names of the entries it created
+  in the directory (its outputs, named before it starts; what else appeared while it held the directory; the
+  figures drawn from it), and their temporary files ``.NAME.tmpPID``.  A file is never removed because of its
+  name: a user's ``figure_from_colleague.png`` or ``.notes.tmp.txt`` is not in the record.  A directory written
+  before the record existed is read by the exact names of its command's outputs.
 * A directory with files that are not a command's output is never touched.
 * One process at a time: an exclusive lock (``.fenics-drill.lock``, released by the
-  kernel when the process dies) refuses a second command on the same directory.
+  kernel when the process dies, and removed when the command ends) refuses a second command on the same
+  directory.
 * While the command works, ``summary.json`` says ``"status": "running"`` with its pid and host; a
   "running" summary whose process is gone (killed, out of memory) reads as ``"killed"``
   (:func:`summary_of`).
@@ -24,6 +30,7 @@ from __future__ import annotations
 
 import fcntl
 import os
+import re
 import shutil
 import socket
 import time
@@ -32,24 +39,28 @@ from pathlib import Path
 from fenics_drill.io.files import UnreadableFile, read_json, write_json
 
 LOCK_NAME = ".fenics-drill.lock"
+#: The record of what fenics-drill wrote in a directory (module doc).
+WRITTEN_RECORD = ".fenics-drill-files.json"
 #: The list of figures drawn from a directory, and the state they were drawn from.
 FIGURE_RECORD = "figures.json"
 
-#: What each command owns in its directory (glob patterns), and what marks a directory as its own
-#: when an older version wrote no ``command`` into ``summary.json``.
+#: The outputs each command writes in its directory under these exact names (the figures a plot draws are
+#: recorded as it draws them).
 OWNED = {
-    "run": ("summary.json", "timeseries.h5", "fields.xdmf", "fields.h5", "fig*.png", "torque_drag.png",
-            "spectra.json", "animation.gif", FIGURE_RECORD),
+    "run": ("summary.json", "timeseries.h5", "fields.xdmf", "fields.h5", "spectra.json", "animation.gif",
+            FIGURE_RECORD),
     "static": ("summary.json", "static.json", "static.xdmf", "static.h5", "static_profiles.h5", "static_path.vtu",
                "static_loads.png", FIGURE_RECORD),
-    "modal": ("summary.json", "modes.json"),
+    "modal": ("summary.json", "modes.json", "modes.png", FIGURE_RECORD),
     "campbell": ("summary.json", "campbell.json", "campbell.png", FIGURE_RECORD),
-    "mc": ("summary.json", "scene.json", "nominal.h5", "nominal.h5.corrupt", "realisations", "statistics.h5", "fig*.png",
+    "mc": ("summary.json", "scene.json", "nominal.h5", "nominal.h5.corrupt", "realisations", "statistics.h5",
            FIGURE_RECORD),
-    "optimize": ("summary.json", "scene.json", "points", "optimize.json", "fig*.png", FIGURE_RECORD),
+    "optimize": ("summary.json", "scene.json", "points", "optimize.json", FIGURE_RECORD),
     "torque-drag": ("summary.json", "torque_drag.json", "torque_drag.h5", "well.vtu", "well_loads.png",
                     "well_path.png", "well_3d.png", FIGURE_RECORD),
 }
+#: A temporary file of an atomic write (:func:`fenics_drill.io.files.temporary_path`): ``.NAME.tmpPID``.
+TEMPORARY = re.compile(r"^\.(?P<name>.+)\.tmp\d+$")
 SIGNATURE = {"run": "timeseries.h5", "static": "static.json", "modal": "modes.json", "campbell": "campbell.json",
              "mc": "realisations", "optimize": "points",
              "torque-drag": "torque_drag.json"}
@@ -127,10 +138,44 @@ def remove_figures(out: Path) -> list[str]:
     return names
 
 
+def recorded_names(out: Path) -> set[str]:
+    """The names of the entries fenics-drill recorded as written in ``out`` (empty without a record)."""
+    try:
+        names = read_json(out / WRITTEN_RECORD).get("files", []) if (out / WRITTEN_RECORD).is_file() else []
+    except UnreadableFile:
+        names = []
+    return {str(name) for name in names if isinstance(name, str) and "/" not in name and name not in ("", ".", "..")}
+
+
+def record_written(out: Path, names) -> None:
+    """Add ``names`` (entries of ``out``) to the record of what fenics-drill wrote there."""
+    names = {Path(name).name for name in names} - {LOCK_NAME, WRITTEN_RECORD}
+    known = recorded_names(out)
+    if not (out / WRITTEN_RECORD).is_file() and (kind := directory_kind(out)) is not None:
+        known = {name for name in owned_names_without_record(out, kind)}  # a directory written before the record
+    if names - known or not (out / WRITTEN_RECORD).is_file():
+        write_json(out / WRITTEN_RECORD, {"files": sorted(known | names)})
+
+
+def owned_names_without_record(out: Path, command: str) -> set[str]:
+    """What ``command`` wrote in a directory written before the record existed: its outputs by their exact names,
+    and the figures ``figures.json`` lists."""
+    names = {name for name in OWNED[command] if (out / name).exists()}
+    try:
+        if (out / FIGURE_RECORD).is_file():
+            names |= {Path(str(n)).name for n in read_json(out / FIGURE_RECORD).get("figures", [])}
+    except UnreadableFile:
+        pass
+    return names
+
+
 def owned_paths(out: Path, command: str) -> list[Path]:
-    """The files and folders of ``out`` that ``command`` owns (its outputs and their temporary files)."""
-    paths = {p for pattern in OWNED[command] for p in out.glob(pattern)}
-    paths |= set(out.glob(".*.tmp*"))
+    """The files and folders of ``out`` that ``command`` wrote: the record's (module doc), or, in a directory
+    without one, the command's outputs by their exact names and the figures ``figures.json`` lists; and their
+    temporary files."""
+    names = recorded_names(out) if (out / WRITTEN_RECORD).is_file() else owned_names_without_record(out, command)
+    paths = {out / name for name in names if (out / name).exists()}
+    paths |= {p for p in out.iterdir() if (m := TEMPORARY.match(p.name)) and m["name"] in names}
     return sorted(paths)
 
 
@@ -143,8 +188,9 @@ def _foreign(out: Path, command: str | None) -> list[Path]:
 class OutputClaim:
     """An output directory held by this process: the lock stays until :meth:`release` or exit."""
 
-    def __init__(self, out: Path, command: str, lock_file):
+    def __init__(self, out: Path, command: str, lock_file, before: set[str] | None = None):
         self.out, self.command, self._lock = out, command, lock_file
+        self._before = before  # the entries of ``out`` when it was claimed (None: a claim that records nothing)
 
     def __enter__(self) -> "OutputClaim":
         return self
@@ -153,27 +199,48 @@ class OutputClaim:
         self.release()
 
     def release(self) -> None:
-        """Give the directory back (idempotent; a claim without a lock, as on MPI ranks > 0, holds nothing)."""
-        if self._lock is not None:
+        """Record what appeared in the directory while it was held and give it back, removing the lock file
+        (idempotent; a claim without a lock, as on MPI ranks > 0, holds nothing)."""
+        if self._lock is None:
+            return
+        try:
+            if self._before is not None and self.out.is_dir():
+                appeared = {p.name for p in self.out.iterdir() if not TEMPORARY.match(p.name)} - self._before
+                record_written(self.out, appeared)
+        except OSError:
+            pass  # a full disk or a removed directory: the record keeps what it had
+        finally:
+            (self.out / LOCK_NAME).unlink(missing_ok=True)  # before unlocking: see _lock for the race
             fcntl.flock(self._lock, fcntl.LOCK_UN)
             self._lock.close()
             self._lock = None
 
 
 def _lock(out: Path):
+    """The exclusive lock of ``out``: its lock file, opened and locked.  A holder removes the file before it
+    unlocks, so a lock taken on a file that is no longer the one at the path is let go and taken again."""
     path = out / LOCK_NAME
-    try:
-        handle = open(path, "a+")
-    except OSError as err:
-        raise OutputError(f"--out {out} is not writable: {err.strerror}") from err
-    try:
-        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError as err:
-        handle.seek(0)
-        holder = handle.read().strip() or "unknown"
+    while True:
+        try:
+            handle = open(path, "a+")
+        except OSError as err:
+            raise OutputError(f"--out {out} is not writable: {err.strerror}") from err
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as err:
+            handle.seek(0)
+            holder = handle.read().strip() or "unknown"
+            handle.close()
+            raise OutputError(f"--out {out} is in use by another fenics-drill process (pid {holder}): wait for "
+                              "it or choose another --out") from err
+        try:
+            current = os.stat(path).st_ino
+        except FileNotFoundError:
+            current = None
+        if current == os.fstat(handle.fileno()).st_ino:
+            break
+        fcntl.flock(handle, fcntl.LOCK_UN)
         handle.close()
-        raise OutputError(f"--out {out} is in use by another fenics-drill process (pid {holder}): wait for "
-                          "it or choose another --out") from err
     handle.seek(0)
     handle.truncate()
     handle.write(str(os.getpid()))
@@ -220,6 +287,8 @@ def claim_output(out: str | Path, command: str, overwrite: bool = False, resume:
             for path in owned_paths(out, command):
                 shutil.rmtree(path) if path.is_dir() else path.unlink()
         remove_figures(out)
+        before = {p.name for p in out.iterdir()}
+        record_written(out, [name for name in OWNED[command] if name not in before])  # named before they exist
         write_json(out / "summary.json", {"command": command, "status": "running", "pid": os.getpid(),
                                           "host": socket.gethostname(),
                                           "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), **(record or {})})
@@ -228,7 +297,7 @@ def claim_output(out: str | Path, command: str, overwrite: bool = False, resume:
         lock.close()
         _leave_nothing(out, created_dir, created_lock)
         raise
-    return OutputClaim(out, command, lock)
+    return OutputClaim(out, command, lock, before)
 
 
 def _leave_nothing(out: Path, created_dir: bool, created_lock: bool) -> None:
@@ -236,6 +305,8 @@ def _leave_nothing(out: Path, created_dir: bool, created_lock: bool) -> None:
     empty, so that a refused command leaves the user's directory as it was."""
     if created_lock:
         (out / LOCK_NAME).unlink(missing_ok=True)
+        if created_dir:
+            (out / WRITTEN_RECORD).unlink(missing_ok=True)
     if created_dir:
         try:
             out.rmdir()

@@ -171,7 +171,11 @@ class BeamDiscretization:
         properties = replace(scene.beam_properties, length=strings[-1].bottom)
         layout = (lambda cells, vertices: fe_sections(scene, well.hole.radius, cells, vertices)) if sectioned else None
         trajectory = well.trajectory if (scene.well.survey or scene.well.md) else None
-        breaks = (*(s.bottom for s in strings), *well.hole.bottoms, *(well.trajectory.md if trajectory else ()))
+        # a vertex at every survey station keeps each element on one arc of constant curvature; a survey denser
+        # than the mesh (a station every few cm) would make the mesh its own: its elements then take the
+        # curvature at their midpoints
+        stations = well.trajectory.md if trajectory and len(well.trajectory.md) <= scene.beam.elements else ()
+        breaks = (*(s.bottom for s in strings), *well.hole.bottoms, *stations)
         return cls(properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports,
                    scene.supports.stabilisers, trajectory, layout, breaks)
 

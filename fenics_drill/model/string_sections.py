@@ -84,6 +84,16 @@ def string_sections(scene) -> list[StringSection]:
     return out
 
 
+def check_sinks(sections: list[StringSection], outer_density: float, inner_density: float) -> None:
+    """Raises SceneError where a section would float in the fluids (a buoyed weight <= 0): the string of these
+    models hangs from the surface."""
+    for s in sections:
+        if s.buoyed_weight(1.0, outer_density, inner_density) <= 0:
+            raise SceneError(f"string section '{s.name}' floats in the mud: its steel of {s.density:g} kg/m^3 is "
+                             f"lighter than the fluid it displaces (fluid.density = {outer_density:g} kg/m^3); "
+                             "check fluid.density and the section's density")
+
+
 def section_at(sections: list[StringSection], md) -> np.ndarray:
     """The index of the section at each measured depth (the deepest section below its bottom)."""
     bottoms = np.array([s.bottom for s in sections])
@@ -117,6 +127,7 @@ def fe_sections(scene, hole_radius_at, cell_x: np.ndarray, vertex_x: np.ndarray)
     g = scene.environment.gravity if scene.model.gravity else 0.0
     outer_fluid, inner_fluid = scene.fluid.density, scene.inner_fluid_density
     k = section_at(sections, cell_x)
+    check_sinks(sections, outer_fluid, inner_fluid)
     body = np.array([math.pi * (s.outer_radius**2 - s.inner_radius**2) for s in sections])
     mass = np.array([s.mass_per_length for s in sections])
     buoyed = np.array([s.buoyed_weight(1.0, outer_fluid, inner_fluid) for s in sections])  # per unit g [kg/m]

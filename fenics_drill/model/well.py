@@ -10,12 +10,14 @@ Coordinates: x north, y east, z up (true vertical depth is -z); the tangent poin
 from __future__ import annotations
 
 import csv
+import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from fenics_drill.scene import SceneError
+from fenics_drill.scene import SceneError, read_regular_file
 
 #: Largest dogleg a pipe can pass in a well [deg per 30 m]: beyond this a survey is refused as a typing error
 #: (the tightest short-radius wells build at about 2-3 deg per metre).
@@ -78,28 +80,90 @@ class Survey:
         return 2.0 * np.arcsin(np.clip(0.5 * np.linalg.norm(t[1:] - t[:-1], axis=1), 0.0, 1.0))
 
 
-def read_survey_csv(path: Path) -> Survey:
-    """A survey from a CSV file with a header naming the columns md, inclination and azimuth (m, degrees; other
-    columns are ignored); errors name the file and the row."""
+#: The largest survey file read [bytes] (100 000 stations take about 3 MB).
+MAX_SURVEY_BYTES = 50_000_000
+#: The names each survey column goes by in a header (lowercase, its unit left out).
+SURVEY_COLUMNS = {"md": ("md", "measured depth", "measured_depth", "measureddepth", "depth"),
+                  "inclination": ("inclination", "inc", "incl"),
+                  "azimuth": ("azimuth", "azi", "az", "azim")}
+#: The units a header may give: to metres for md, to degrees for the angles.
+LENGTH_UNITS = {"": 1.0, "m": 1.0, "metre": 1.0, "metres": 1.0, "meter": 1.0, "meters": 1.0, "ft": 0.3048,
+                "feet": 0.3048, "foot": 0.3048, "usft": 1200.0 / 3937.0}
+ANGLE_UNITS = {"": 1.0, "deg": 1.0, "degree": 1.0, "degrees": 1.0, "°": 1.0, "rad": 180.0 / math.pi}
+_UNIT = re.compile(r"^(?P<name>.*?)\s*[(\[]\s*(?P<unit>[^()\[\]]*?)\s*[)\]]\s*$")
+
+
+def _survey_text(path: Path) -> str:
+    """The text of a survey file: a regular file of at most MAX_SURVEY_BYTES, in UTF-8 (with or without a byte
+    order mark) or, failing that, Latin-1 (a degree sign written by an older exporter); a binary file is refused."""
     try:
-        with open(path, newline="") as f:
-            rows = list(csv.DictReader(f))
-    except OSError as err:
-        raise SurveyError(f"survey file {path} cannot be read: {err.strerror}") from err
-    if not rows:
+        data = read_regular_file(path, "survey file", MAX_SURVEY_BYTES, "a CSV text of stations")
+    except SceneError as err:
+        raise SurveyError(str(err)) from None
+    if b"\x00" in data:
+        raise SurveyError(f"survey file {path} is a binary file, not a CSV text of stations (md, inclination, "
+                          "azimuth)")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        text = data.decode("latin-1")
+    if any(ord(c) < 32 and c not in "\t\r\n" for c in text):
+        raise SurveyError(f"survey file {path} holds control characters: it is not a CSV text of stations")
+    return text
+
+
+def _survey_column(header: str, path: Path) -> tuple[str | None, float]:
+    """(the survey column a header cell names, or None; the factor of its unit to m or degrees)."""
+    cell = header.strip().strip('"').strip()
+    match = _UNIT.match(cell)
+    name, unit = (match["name"], match["unit"]) if match else (cell, "")
+    name, unit = " ".join(name.lower().split()), unit.strip().lower()
+    for column, aliases in SURVEY_COLUMNS.items():
+        if name in aliases:
+            units = LENGTH_UNITS if column == "md" else ANGLE_UNITS
+            if unit not in units:
+                raise SurveyError(f"survey file {path}: column {cell!r} has the unit {unit!r}, which is not one of "
+                                  f"{', '.join(u for u in units if u)}")
+            return column, units[unit]
+    return None, 1.0
+
+
+def read_survey_csv(path: Path) -> Survey:
+    """A survey from a CSV file: a header naming the columns md, inclination and azimuth (or MD, Inc, Azi, with
+    their units in brackets: m or ft, deg or rad; other columns are ignored), then one station per line; commas,
+    semicolons or tabs between the fields; lines starting with # and blank lines are skipped.  Errors name the
+    file and the line."""
+    lines = [(k, line) for k, line in enumerate(_survey_text(path).splitlines(), start=1)
+             if line.strip() and not line.lstrip().startswith("#")]
+    if not lines:
         raise SurveyError(f"survey file {path} holds no stations")
-    columns = {name.strip().lower(): name for name in rows[0]}
-    missing = [c for c in ("md", "inclination", "azimuth") if c not in columns]
+    header_line, header = lines[0]
+    delimiter = next((d for d in (",", ";", "\t") if d in header), ",")
+    names = next(csv.reader([header], delimiter=delimiter))
+    found = {}
+    for index, cell in enumerate(names):
+        column, factor = _survey_column(cell, path)
+        if column is not None and column not in found:
+            found[column] = (index, factor)
+    missing = [c for c in SURVEY_COLUMNS if c not in found]
     if missing:
-        raise SurveyError(f"survey file {path}: no column {', '.join(missing)} (its header names "
-                          f"{', '.join(columns)}); the columns are md [m], inclination and azimuth [deg]")
-    values = {c: [] for c in ("md", "inclination", "azimuth")}
-    for k, row in enumerate(rows, start=2):
-        for c in values:
+        shown = ", ".join(repr(n.strip()) for n in names)
+        raise SurveyError(f"survey file {path}, line {header_line}: no column {', '.join(missing)} (the header names "
+                          f"{shown}); the columns are md [m or ft], inclination and azimuth [deg]")
+    values = {c: [] for c in SURVEY_COLUMNS}
+    for k, line in lines[1:]:
+        fields = next(csv.reader([line], delimiter=delimiter))
+        if len(fields) != len(names):
+            raise SurveyError(f"survey file {path}, line {k}: {len(fields)} fields where the header names "
+                              f"{len(names)}")
+        for column, (index, factor) in found.items():
             try:
-                values[c].append(float(row[columns[c]]))
-            except (TypeError, ValueError):
-                raise SurveyError(f"survey file {path}, line {k}: {c} = {row[columns[c]]!r} is not a number") from None
+                values[column].append(float(fields[index]) * factor)
+            except ValueError:
+                raise SurveyError(f"survey file {path}, line {k}: {column} = {fields[index].strip()!r} is not a "
+                                  "number") from None
+    if not values["md"]:
+        raise SurveyError(f"survey file {path} holds a header but no stations")
     return Survey.of(values["md"], values["inclination"], values["azimuth"], where=f"survey file {path}")
 
 
@@ -313,4 +377,11 @@ def well_of(scene, string_length: float) -> Well:
     if string_length > depth * (1 + 1e-9):
         raise SceneError(f"the string ({string_length:g} m) is longer than the well ({depth:g} m of measured depth): "
                          "shorten string.sections or extend the survey")
-    return Well(Trajectory(survey), HoleSections(bottoms, radii, cased))
+    trajectory = Trajectory(survey)
+    above = np.flatnonzero(trajectory.stations[:, 2] > 1e-9 * max(depth, 1.0))
+    if above.size:
+        k = int(above[0])
+        raise SceneError(f"the survey rises above the surface: at md = {survey.md[k]:g} m (station {k + 1}) the well "
+                         f"is {trajectory.stations[k, 2]:.4g} m above the ground; check the inclinations (above 90 "
+                         "deg the hole climbs)")
+    return Well(trajectory, HoleSections(bottoms, radii, cased))

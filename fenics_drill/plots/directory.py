@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from fenics_drill.io.files import UnreadableFile, read_json, write_json
-from fenics_drill.io.output_directory import FIGURE_RECORD, summary_of
+from fenics_drill.io.output_directory import FIGURE_RECORD, record_written, summary_of
 from fenics_drill.io.timeseries import read_series
 from fenics_drill.plots.common import DRAWN_FROM
 
@@ -34,6 +34,7 @@ def plot_directory(directory: Path, gif: bool = True) -> list[Path]:
     finally:
         DRAWN_FROM.reset(token)
     write_json(directory / FIGURE_RECORD, {"drawn_from": state, "figures": [p.name for p in paths]})
+    record_written(directory, [*(p.name for p in paths), FIGURE_RECORD])
     return paths
 
 

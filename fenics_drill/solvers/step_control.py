@@ -29,6 +29,7 @@ import numpy as np
 
 from fenics_drill.model.resolution import band_frequency
 from fenics_drill.model.reduction.spaces import column_bound, stack_rows
+from fenics_drill.scene import SceneError
 
 
 class StepTooSmall(RuntimeError):
@@ -41,6 +42,22 @@ def nominal_step(scene) -> float:
     if scene.time.dt > 0:
         return scene.time.dt
     return 1.0 / (scene.time.band_steps * band_frequency(scene))
+
+
+def least_steps(scene) -> float:
+    """The fewest steps a run of the scene takes: time.t_end over its largest step, the nominal one."""
+    return scene.time.t_end / nominal_step(scene)
+
+
+def check_run_length(scene) -> None:
+    """Refuse, before any work, a run that needs more than ``time.max_steps`` steps at its largest step (a time.dt
+    of 1e-9 s over 10 s is 1e10 steps: days), naming the keys."""
+    steps = least_steps(scene)
+    if steps > scene.time.max_steps:
+        raise SceneError(f"time.t_end = {scene.time.t_end:g} s at a step of at most {nominal_step(scene):.3g} s needs at "
+                         f"least {steps:.3g} steps, more than time.max_steps = {scene.time.max_steps:g} (about "
+                         f"{steps * 1e-3 / 3600:.3g} h at 1 ms per step); raise time.dt or lower time.t_end, or raise "
+                         "time.max_steps to run it")
 
 
 def steps_per_band_period(scene) -> float:

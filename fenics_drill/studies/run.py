@@ -35,7 +35,8 @@ from fenics_drill.observables.whirl import whirl
 from fenics_drill.scene import Time
 from fenics_drill.solvers.static import StaticFailure, static_report
 from fenics_drill.model.resolution import band_frequency, mesh_advice
-from fenics_drill.solvers.step_control import StepTooSmall, nominal_step, steps_per_band_period
+from fenics_drill.solvers.step_control import (StepTooSmall, check_run_length, least_steps, nominal_step,
+                                              steps_per_band_period)
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
 from fenics_drill.studies.lifecycle import StopOnSignal, command_output, uninterrupted
 from fenics_drill.studies.prepare import prepare
@@ -81,13 +82,17 @@ RINGING_RATIO = 20.0
 SMALL_ADVANCE = 20.0
 
 
-def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
+def run_static(scene, out: str | Path, overwrite: bool = False, progress: bool = True) -> dict:
     """Static equilibrium of the scene (Section 6.4): DIR/static.json, DIR/static.xdmf, DIR/summary.json; on a well
     DIR/static_profiles.h5 (:func:`~fenics_drill.studies.torque_drag.fe_static_profiles`) and static_path.vtu (the
     string where it lies in the hole, for ParaView)."""
     out = Path(out)
     with command_output(out, "static", scene, overwrite) as summary:
-        prepared = prepare(scene, dynamics=False)
+        setup = SetupProgress(progress)
+        try:
+            prepared = prepare(scene, dynamics=False, stage=setup)
+        finally:
+            setup.close()
         model, equilibrium = prepared.model, prepared.equilibrium
         report = static_report(model, equilibrium)
         report["reduced_size"] = model.size
@@ -108,6 +113,10 @@ def run_static(scene, out: str | Path, overwrite: bool = False) -> dict:
     return report
 
 
+#: The share of the run after which the progress line gives an estimate of the time left.
+ETA_AFTER = 0.01
+
+
 class Progress:
     """A progress report on stderr: simulated time, steps, step size, wall time, ETA.  On a terminal one
     line rewritten every 2 s; in a log file (a batch job) one line every 30 s."""
@@ -121,9 +130,10 @@ class Progress:
         if not self.enabled or (wall - self.last < self.every_s and t < t_end):
             return
         self.last = wall
-        eta = wall * (t_end - t) / t if t > 0 else float("nan")
+        # the first steps (the start-up from rest, at a fraction of the nominal step) say nothing of the rest
+        eta = f"{wall * (t_end - t) / t:7.1f} s" if t >= ETA_AFTER * t_end else "    ..."
         line = (f"  t = {t:8.4f} / {t_end:g} s ({100 * t / t_end:5.1f}%)  steps {stats['steps']:7d}  "
-                f"dt {dt:.2e} s  wall {wall:7.1f} s  eta {eta:7.1f} s")
+                f"dt {dt:.2e} s  wall {wall:7.1f} s  eta {eta}")
         done = t >= t_end * (1 - 1e-12)
         sys.stderr.write(f"\r{line}" + ("\n" if done else "") if self.terminal else f"{line}\n")
         sys.stderr.flush()
@@ -240,6 +250,7 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
         return second_rank_run(scene, comm, comm.bcast(None, root=0))
     try:
         check_memory(scene.beam.elements, scene.beam.element_degree)
+        check_run_length(scene)
         _check_disk_for_run(scene, out)
         claim = claim_output(out, "run", overwrite)
     except Exception as err:
@@ -284,6 +295,10 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
             recorder = RunRecorder(model, scene, out, on_write=running)
             u0 = model.bit_state(start.q, start.qd)[0]
             summary["nominal_dt"] = nominal_step(scene)
+            if progress:  # the length of the run before it starts (the progress line's estimate follows)
+                sys.stderr.write(f"  {scene.time.t_end:g} s at a step of at most {summary['nominal_dt']:.3g} s: at "
+                                 f"least {least_steps(scene):.0f} steps\n")
+                sys.stderr.flush()
             loop_clock = time.perf_counter()
             try:
                 final = simulation.run(start, scene.time.t_end, recorder, Progress(progress), atomic=atomic)

@@ -32,6 +32,10 @@ def _fluids(scene) -> tuple[float, float]:
     return outer, outer if scene.fluid.inner_density == -1.0 else scene.fluid.inner_density
 
 
+#: The most elements of the soft string a study takes (1 cm elements along 10 km; its loads converge at 10 m).
+MAX_SOFT_STRING_ELEMENTS = 1e6
+
+
 def torque_drag_study(scene) -> dict:
     """The soft-string study of a scene: ``report`` (JSON-ready) and ``profiles`` (an ``xarray.Dataset``: node values
     over ``md``, element values over ``md_element``)."""
@@ -42,6 +46,12 @@ def torque_drag_study(scene) -> dict:
     outer, inner = _fluids(scene)
     weights = np.array([s.buoyed_weight(g, outer, inner) for s in sections])
     td = scene.torque_drag
+    elements = sections[-1].bottom / td.element_length
+    if elements > MAX_SOFT_STRING_ELEMENTS:
+        raise SceneError(f"torque_drag.element_length = {td.element_length:g} m is not admissible for this "
+                         f"{sections[-1].bottom:g} m string: {elements:.3g} elements, more than "
+                         f"{MAX_SOFT_STRING_ELEMENTS:g} (the soft string converges at 10 m elements: "
+                         "docs/wells.md)")
     mesh = string_mesh(well, sections, td.element_length, weights, td.friction_cased, td.friction_open)
     middle = 0.5 * (mesh.md[1:] + mesh.md[:-1])
     clearance = well.hole.radius(middle) - mesh.contact_radius

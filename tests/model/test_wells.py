@@ -116,7 +116,7 @@ def test_a_survey_that_cannot_describe_a_well_is_refused_with_its_station(tmp_pa
     with pytest.raises(SurveyError, match="more than any pipe can pass"):
         Survey.of([0, 10], [0, 90], [0, 0])  # 270 deg/30 m: a typing error
     bad = tmp_path / "survey.csv"
-    bad.write_text("md,inc,azimuth\n0,0,0\n")
+    bad.write_text("md,dip,azimuth\n0,0,0\n")
     with pytest.raises(SurveyError, match="no column inclination"):
         read_survey_csv(bad)
     bad.write_text("md,inclination,azimuth\n0,0,0\n100,x,0\n")
