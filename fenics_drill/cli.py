@@ -441,6 +441,9 @@ def _main(argv: list[str] | None) -> int:
         if MPI.COMM_WORLD.size > 1:
             if MPI.COMM_WORLD.rank > 0:
                 return 0  # the first rank runs the command; this one has nothing to do
+            import petsc4py
+
+            petsc4py.init(comm=MPI.COMM_SELF)  # PETSc's start and end are collective: this rank's alone
             _say(f"fenics-drill: '{args.command}' runs on one process: rank 0 runs it, the other "
                  f"{MPI.COMM_WORLD.size - 1} end")
     if argv is None and args.command in SUPERVISED and not _under_mpiexec():
