@@ -20,6 +20,7 @@ a scene file (one changed with ``dataclasses.replace`` included) and refuses it 
 from __future__ import annotations
 
 import functools
+import inspect
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -65,9 +66,15 @@ def python_phrasing(message: str) -> str:
 def _entry(function):
     """An API call: its scene checked again (:func:`~fenics_drill.scene.checked`), an output directory's refusal in
     the Python arguments' words."""
+    signature = inspect.signature(function)
+
     @functools.wraps(function)
     def call(scene, *args, **kwargs):
         scene = checked(scene)
+        out = signature.bind(scene, *args, **kwargs).arguments.get("out")
+        if out is not None and not str(out).strip():
+            raise OutputError("out='' names no directory (it would write into the current one): give one, e.g. "
+                              "out='out/run1', or None")
         try:
             return function(scene, *args, **kwargs)
         except OutputError as err:

@@ -25,11 +25,6 @@ SUPERVISED = ("run", "static", "modal", "campbell")
 SINGLE_PROCESS = ("scene", "modal", "static", "campbell", "plot", "forms", "torque-drag")
 
 
-def _output_directory(text: str) -> str:
-    """``--out``: a directory name, not an empty string (which would write into the current directory)."""
-    if not text.strip():
-        raise argparse.ArgumentTypeError("an empty --out names no directory: give one, e.g. --out out/run1")
-    return text
 
 
 def _scene_args(parser: argparse.ArgumentParser, out: bool = True) -> None:
@@ -39,8 +34,7 @@ def _scene_args(parser: argparse.ArgumentParser, out: bool = True) -> None:
         help="override one scene key; the value is read as TOML (repeatable)",
     )
     if out:
-        parser.add_argument("--out", default="out", type=_output_directory,
-                            help="output directory (created if missing; it must be new "
+        parser.add_argument("--out", default="out", help="output directory (created if missing; it must be new "
                             "or empty, or hold this command's earlier output with --overwrite)")
         parser.add_argument("--overwrite", action="store_true",
                             help="replace this command's earlier output in --out (and nothing else there)")
@@ -99,7 +93,7 @@ def cmd_static(args) -> int:
     if (Path(args.out) / "static_profiles.h5").exists():  # a well: its loads along it
         from fenics_drill.plots.directory import plot_directory
 
-        plot_directory(Path(args.out))
+        _drawn(lambda: plot_directory(Path(args.out)))
     print(
         f"max sag {report['max_sag'] * 1e3:.3f} mm at x = {report['max_sag_position']:.1f} m, "
         f"{len(report['contact_vertices'])} vertices on the wall, hook load {report['hook_load'] / 1e3:.2f} kN "
@@ -159,14 +153,9 @@ def cmd_run(args) -> int:
 
 def cmd_mc(args) -> int:
     """Monte Carlo over the random bit-rock laws; with mpiexec -n P, realisations spread over P ranks."""
-    from fenics_drill.scene import MAX_SAMPLES
     from fenics_drill.studies.monte_carlo import monte_carlo
 
     scene = load_scene(args.scene, args.overrides)
-    if not 1 <= args.samples <= MAX_SAMPLES:
-        print(f"fenics-drill: --samples {args.samples} is not admissible: must be in [1, {MAX_SAMPLES}]",
-              file=sys.stderr)
-        return 2
     summary = monte_carlo(scene, args.samples, args.out, resume=args.resume, progress=not args.quiet,
                           overwrite=args.overwrite)
     if summary is not None:
@@ -195,6 +184,18 @@ def cmd_optimize(args) -> int:
     return 0
 
 
+def _drawn(draw):
+    """``draw()``, with a line on stderr every 10 s after 5 s while the figures are drawn."""
+    from fenics_drill.studies.run import SetupProgress
+
+    progress = SetupProgress(True, prefix="figures")
+    progress("drawing")
+    try:
+        return draw()
+    finally:
+        progress.close()
+
+
 def cmd_plot(args) -> int:
     """Figures of a saved run (Figs. 13-23), Monte Carlo study (Figs. 28-35) or operating window (24-27, 36)."""
     from fenics_drill.io.files import read_json
@@ -202,7 +203,7 @@ def cmd_plot(args) -> int:
     from fenics_drill.plots.directory import plot_directory
 
     directory = Path(args.run_dir)
-    paths = plot_directory(directory, gif=not args.no_gif)
+    paths = _drawn(lambda: plot_directory(directory, gif=not args.no_gif))
     print(f"{len(paths)} files in {directory}: " + ", ".join(p.name for p in paths))
     banner = read_json(directory / FIGURE_RECORD)["drawn_from"].get("banner")
     if banner:
@@ -248,7 +249,7 @@ def cmd_torque_drag(args) -> int:
 
     scene = load_scene(args.scene, args.overrides)
     report = write_torque_drag(scene, args.out, overwrite=args.overwrite)["report"]
-    plot_directory(Path(args.out))
+    _drawn(lambda: plot_directory(Path(args.out)))
     well = report["well"]
     print(f"{well['measured_depth_m']:.0f} m well (TVD {well['true_vertical_depth_m']:.0f} m, max dogleg "
           f"{well['max_dogleg_deg_per_30m']:.2f} deg/30 m), {report['string']['length_m']:.0f} m string, "
@@ -435,6 +436,10 @@ def _main(argv: list[str] | None) -> int:
     sys.unraisablehook, sys.excepthook = _quiet_about_full_disks, _quiet_excepthook
     parser = build_parser()
     args = parser.parse_args(argv)
+    if getattr(args, "out", None) is not None and not str(args.out).strip():
+        _say("fenics-drill: --out '' names no directory (it would write into the current one): give one, e.g. "
+             "--out out/run1")
+        return 2
     if args.command in SINGLE_PROCESS and _under_mpiexec():
         from mpi4py import MPI
 

@@ -23,7 +23,7 @@ from fenics_drill.io.files import UnreadableFile, usable_result
 from fenics_drill.io.realisations import NOMINAL, read_realisation, realisation_path, write_realisation
 from fenics_drill.io.study_directory import all_done, claim, polled_barrier, stopped_rank
 from fenics_drill.model.resources import check_memory
-from fenics_drill.scene import check_history_grid
+from fenics_drill.scene import MAX_SAMPLES, SceneError, check_history_grid
 from fenics_drill.studies.lifecycle import stop_if_requested, study_run
 from fenics_drill.studies.prepare import prepare, run_realisation
 from fenics_drill.studies.statistics import write_statistics
@@ -49,6 +49,9 @@ def _progress(out: Path, samples: int, started: float, done_at_start: int) -> No
 def monte_carlo(scene, samples: int, out: str | Path, resume: bool = False, progress: bool = True,
                 comm=MPI.COMM_WORLD, overwrite: bool = False) -> dict | None:
     """Run (or finish) the study; rank 0 returns the summary, the other ranks None."""
+    if isinstance(samples, bool) or not isinstance(samples, int) or not 1 <= samples <= MAX_SAMPLES:
+        raise SceneError(f"the number of realisations (--samples) {samples!r} is not admissible: must be an integer in "
+                         f"[1, {MAX_SAMPLES}]")
     out = Path(out)
     laws = BitRockLaws(scene.bit_rock, scene.uncertainty)  # refuses inadmissible laws
     check_history_grid(scene)

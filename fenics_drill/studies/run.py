@@ -140,11 +140,12 @@ class Progress:
 
 
 class SetupProgress:
-    """Progress of a set-up that lasts: after ``quiet_s`` seconds, a line on stderr every ``every_s`` seconds
-    naming the part under way (a background thread, so that a long part is reported while it runs)."""
+    """Progress of a stage that lasts (a set-up, the drawing of figures): after ``quiet_s`` seconds, a line on stderr
+    every ``every_s`` seconds naming the part under way, after ``prefix`` (a background thread, so that a long part
+    is reported while it runs)."""
 
-    def __init__(self, enabled: bool, quiet_s: float = 5.0, every_s: float = 10.0):
-        self.enabled, self.quiet_s, self.every_s = enabled, quiet_s, every_s
+    def __init__(self, enabled: bool, quiet_s: float = 5.0, every_s: float = 10.0, prefix: str = "set-up"):
+        self.enabled, self.quiet_s, self.every_s, self.prefix = enabled, quiet_s, every_s, prefix
         self.current, self.started = "", time.perf_counter()
         self.done = threading.Event()
         if enabled:
@@ -157,7 +158,7 @@ class SetupProgress:
         if self.done.wait(self.quiet_s):
             return
         while True:
-            sys.stderr.write(f"  set-up: {self.current} ({time.perf_counter() - self.started:.0f} s)\n")
+            sys.stderr.write(f"  {self.prefix}: {self.current} ({time.perf_counter() - self.started:.0f} s)\n")
             sys.stderr.flush()
             if self.done.wait(self.every_s):
                 return

@@ -269,9 +269,14 @@ def test_the_api_names_its_own_arguments_in_an_output_directorys_message(tmp_pat
 
 
 def test_an_empty_out_is_refused(tmp_path, capsys):
-    with pytest.raises(SystemExit) as exit_:
-        main(["static", PAPER, "--out", ""])
-    assert exit_.value.code == 2 and "an empty --out names no directory" in capsys.readouterr().err
+    refused(capsys, ["static", PAPER, "--out", ""], "--out '' names no directory")
+
+
+def test_a_monte_carlo_of_no_realisation_is_refused_from_python_too(tmp_path, capsys):
+    refused(capsys, ["mc", PAPER, "--samples", "0", "--out", str(tmp_path / "o")], "(--samples) 0")
+    with pytest.raises(fd.SceneError, match=r"\(--samples\) 0 is not admissible"):
+        fd.monte_carlo(fd.load_scene(PAPER), samples=0, out=tmp_path / "o")
+    assert not (tmp_path / "o").exists()
 
 
 def test_the_scene_command_reads_the_survey_file(tmp_path, capsys):
