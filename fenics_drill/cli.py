@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 from fenics_drill import __version__
-from fenics_drill.scene import SceneError, load_scene, section_keys
+from fenics_drill.scene import SceneError, load_scene, section_keys, unused_keys
 
 #: Commands run in a supervised worker process (single-process commands that can run long).
 SUPERVISED = ("run", "static", "modal", "campbell")
@@ -49,12 +49,20 @@ def cmd_scene(args) -> int:
         from fenics_drill.model.well import well_of
 
         well_of(scene, string_sections(scene)[-1].bottom)
+    written = getattr(scene, "written", {})
+    unused = unused_keys(scene)
     for section, entries in scene.to_dict().items():
         print(f"[{section}]")
         keys = section_keys(section)
         for key, value in entries.items():
-            print(f"{key} = {json.dumps(value)}  # {keys[key].metadata['doc']}")
+            given = f" (written {written[f'{section}.{key}']!r})" if f"{section}.{key}" in written else ""
+            note = "  [not used: the well's keys rule]" if f"{section}.{key}" in unused else ""
+            print(f"{key} = {json.dumps(value)}  # {keys[key].metadata['doc']}{given}{note}")
         print()
+    sections_written = {k: v for k, v in written.items() if k.startswith("string.sections[")}
+    if sections_written:
+        print("# written with units in string.sections (shown above in SI): "
+              + ", ".join(f"{k} = {v!r}" for k, v in sections_written.items()))
     return 0
 
 

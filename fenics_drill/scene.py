@@ -353,10 +353,39 @@ SECTION_KEYS = {
 }
 
 
+
 #: The material keys of a string section take the admissible values of their [beam] defaults.
 SECTION_RANGES = {name: (Beam.__dataclass_fields__[name].metadata["check"],
                          Beam.__dataclass_fields__[name].metadata["admissible"])
                   for name in ("density", "young_modulus", "poisson_ratio")}
+
+
+#: The diameters a section may give instead of its radii.
+SECTION_DIAMETERS = {"outer_diameter": "outer_radius", "inner_diameter": "inner_radius",
+                     "tool_joint_outer_diameter": "tool_joint_outer_radius",
+                     "tool_joint_inner_diameter": "tool_joint_inner_radius"}
+
+
+def _section_in_si(k: int, table, written: dict) -> Any:
+    """A table of ``string.sections`` with its values written with units in SI (:func:`with_unit`) and its
+    diameters as radii; anything else as it was (the checks of :func:`_string_sections` follow)."""
+    if not isinstance(table, dict):
+        return table
+    where, out = f"string.sections[{k}]", {}
+    for name, value in table.items():
+        if isinstance(value, str) and name != "name":
+            written[f"{where}.{name}"] = value
+            meaning = SECTION_KEYS.get(name) or SECTION_KEYS.get(SECTION_DIAMETERS.get(name, ""), "")
+            value = with_unit(f"{where}.{name}", value, meaning)
+        if name in SECTION_DIAMETERS:
+            radius = SECTION_DIAMETERS[name]
+            if radius in table:
+                raise SceneError(f"{where}: {name} and {radius} are not admissible together: give one")
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise SceneError(f"{where}.{name} = {value!r} is not admissible: must be a number >= 0")
+            name, value = radius, 0.5 * value
+        out[name] = value
+    return out
 
 
 def _string_sections(sections) -> bool:
@@ -551,9 +580,26 @@ def _describe_kind(kind) -> str:
     return names.get(kind, getattr(kind, "__name__", str(kind)))
 
 
+def with_unit(name: str, value: str, meaning: str) -> float:
+    """A value written with its unit ("120 rpm") in the SI unit of the key's ``meaning`` (:mod:`fenics_drill.units`),
+    or a SceneError naming the key."""
+    from fenics_drill.units import UnitError, si_unit, to_si
+
+    unit = si_unit(meaning)
+    if unit is None:
+        raise SceneError(f"{name} = {value!r} is not admissible: expected a number (this key takes no unit)")
+    try:
+        return to_si(value, unit)
+    except UnitError as err:
+        raise SceneError(f"{name} = {value!r} is not admissible: {err}") from None
+
+
 def _coerce(name: str, value: Any, kind: type, meta) -> Any:
-    """Return ``value`` converted to the key's type, or raise SceneError."""
+    """Return ``value`` converted to the key's type (a number written with its unit to the key's SI unit), or raise
+    SceneError."""
     bad = SceneError(f"{name} = {value!r} is not admissible: expected {_describe_kind(kind)}")
+    if kind is float and isinstance(value, str):
+        value = with_unit(name, value, meta["doc"])
     if kind is float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise bad
@@ -584,15 +630,17 @@ def _coerce(name: str, value: Any, kind: type, meta) -> Any:
 def _check_relations(scene: Scene) -> Scene:
     """Checks between keys; resolves ``output.section = -1`` to L/2."""
     beam, hole = scene.beam, scene.borehole
-    if beam.inner_radius >= beam.outer_radius:
-        raise SceneError(f"beam.inner_radius = {beam.inner_radius!r} is not admissible: "
-                         f"must be < beam.outer_radius = {beam.outer_radius!r}")
-    if hole.radius <= beam.outer_radius:
+    unused = unused_keys(scene)  # a well's own string and hole: the one pipe and hole of [beam], [borehole] unused
+    if "beam.outer_radius" not in unused:
+        if beam.inner_radius >= beam.outer_radius:
+            raise SceneError(f"beam.inner_radius = {beam.inner_radius!r} is not admissible: "
+                             f"must be < beam.outer_radius = {beam.outer_radius!r}")
+        if beam.length < 10.0 * beam.outer_radius:
+            raise SceneError(f"beam.length = {beam.length!r} is not admissible: must be >= 10 beam.outer_radius = "
+                             f"{10.0 * beam.outer_radius:g} m (a beam model needs a slender string)")
+    if not unused and hole.radius <= beam.outer_radius:
         raise SceneError(f"borehole.radius = {hole.radius!r} is not admissible: must be > beam.outer_radius = "
                          f"{beam.outer_radius!r} (the string must fit in the hole)")
-    if beam.length < 10.0 * beam.outer_radius:
-        raise SceneError(f"beam.length = {beam.length!r} is not admissible: must be >= 10 beam.outer_radius = "
-                         f"{10.0 * beam.outer_radius:g} m (a beam model needs a slender string)")
     length = scene.string_length
     if scene.output.section == -1.0:
         scene = dataclasses.replace(scene, output=dataclasses.replace(scene.output, section=0.5 * length))
@@ -614,9 +662,16 @@ def _check_relations(scene: Scene) -> Scene:
                          "its linear spring the wall lets the string through (k_FS2 delta^3 is negligible at small "
                          "penetrations); give k_FS1 > 0, or set model.contact = false to leave the wall out")
     bit, drive = scene.bit_rock, scene.drive
-    if bit.law == "detournay" and bit.bit_radius > hole.radius:
-        raise SceneError(f"bit_rock.bit_radius = {bit.bit_radius!r} is not admissible: must be <= borehole.radius = "
-                         f"{hole.radius!r} (the bit cuts the hole)")
+    if bit.law == "detournay":
+        hole_at_bit, which = hole.radius, "borehole.radius"
+        if scene.well.hole_radius and scene.well.hole_bottom:  # the well's hole section at the bit
+            bottoms = list(scene.well.hole_bottom)
+            k = next((i for i, b in enumerate(bottoms) if b >= scene.string_length * (1 - 1e-12)), len(bottoms) - 1)
+            k = min(k, len(scene.well.hole_radius) - 1)
+            hole_at_bit, which = scene.well.hole_radius[k], f"well.hole_radius[{k + 1}] (the hole at the bit)"
+        if bit.bit_radius > hole_at_bit * (1 + 1e-9):
+            raise SceneError(f"bit_rock.bit_radius = {bit.bit_radius!r} is not admissible: must be <= {which} = "
+                             f"{hole_at_bit!r} (the bit cuts the hole)")
     if drive.mode == "hook_load":
         if not scene.model.bit_rock:
             raise SceneError("drive.mode = 'hook_load' is not admissible with model.bit_rock = false: nothing "
@@ -692,7 +747,7 @@ def _check_stabilisers(scene: Scene) -> None:
 
 def validate(raw: dict[str, Any]) -> Scene:
     """Check every key of ``raw`` (sections of keys) and its relations; missing keys take their defaults."""
-    sections = {}
+    sections, written = {}, {}
     for section, entries in raw.items():
         if section not in SECTIONS:
             raise SceneError(f"unknown section [{section}]; known sections: {', '.join(SECTIONS)}")
@@ -703,9 +758,26 @@ def validate(raw: dict[str, Any]) -> Scene:
         for name, value in entries.items():
             if name not in keys:
                 raise SceneError(f"unknown key {section}.{name}; known keys of [{section}]: {', '.join(keys)}")
+            if isinstance(value, str) and kinds[name] is float:
+                written[f"{section}.{name}"] = value
+            if section == "string" and name == "sections" and isinstance(value, (list, tuple)):
+                value = [_section_in_si(k, table, written) for k, table in enumerate(value, start=1)]
             values[name] = _coerce(f"{section}.{name}", value, kinds[name], keys[name].metadata)
         sections[section] = SECTIONS[section](**values)
-    return _check_relations(Scene(**sections))
+    scene = _check_relations(Scene(**sections))
+    object.__setattr__(scene, "written", written)  # what the user wrote with a unit (``fenics-drill scene``)
+    return scene
+
+
+def unused_keys(scene: Scene) -> set[str]:
+    """The keys a scene's well leaves unused: with ``[string]`` sections, the one pipe of [beam] (its length and
+    radii) and the straight hole of [borehole] when the well gives its hole sections."""
+    unused = set()
+    if scene.string.sections:
+        unused |= {"beam.length", "beam.outer_radius", "beam.inner_radius"}
+    if scene.well.hole_radius:
+        unused |= {"borehole.radius"}
+    return unused
 
 
 def checked(scene) -> Scene:
