@@ -42,10 +42,13 @@ reproduction: setup
 test: setup
 	$(PY) -m pytest -q tests
 
-## The manual into docs/_build/html: warnings (a broken internal link, a bad reference) are errors, and the
-## gallery's scripts run (about 2 minutes).
+## The manual into docs/_build/html: warnings (a broken internal link, a bad reference) are errors, the
+## gallery's scripts run (about 2 minutes), and the equations render offline (MathJax shipped with the site).
 docs: setup
 	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
+	@# the equations render offline: MathJax is served from the site itself, no page asks a CDN for it
+	@test -f docs/_build/html/_static/mathjax/tex-chtml.js
+	@! grep -l "cdn.jsdelivr.net/npm/mathjax" docs/_build/html/*.html docs/_build/html/*/*.html
 
 ## Speed against an older revision (benchmarks/results/speed.md, about 5 min), the cost of each part of an evaluation,
 ## the reduced models against the full order (benchmarks/results/reduced_accuracy.md), then the fidelity studies

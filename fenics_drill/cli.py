@@ -102,11 +102,13 @@ def cmd_static(args) -> int:
         from fenics_drill.plots.directory import plot_directory
 
         _drawn(lambda: plot_directory(Path(args.out)))
-    print(
-        f"max sag {report['max_sag'] * 1e3:.3f} mm at x = {report['max_sag_position']:.1f} m, "
-        f"{len(report['contact_vertices'])} vertices on the wall, hook load {report['hook_load'] / 1e3:.2f} kN "
-        f"-> {Path(args.out) / 'static.json'}"
-    )
+    if scene.well.survey or scene.well.md:  # in a well the lateral displacement is off the axis, any way
+        shape = f"largest lateral displacement {report['max_lateral_displacement'] * 1e3:.3f} mm"
+    else:
+        shape = f"max sag {report['max_sag'] * 1e3:.3f} mm at x = {report['max_sag_position']:.1f} m"
+    pressed = f", the bit pressed at {report['weight_on_bit'] / 1e3:.4g} kN" if report.get("weight_on_bit") else ""
+    print(f"{shape}, {len(report['contact_vertices'])} vertices on the wall, hook load {report['hook_load'] / 1e3:.2f} "
+          f"kN{pressed} -> {Path(args.out) / 'static.json'}")
     for reason in report.get("suspect_reasons", []):
         print(f"suspect: {reason}")
     return 0

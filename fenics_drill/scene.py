@@ -151,7 +151,9 @@ class Drive:
                                 "controller) [rad/s]")
     mode: str = key("velocity", "axial drive: 'velocity' (u(0) = V0 t) or 'hook_load' (push with drive.weight_on_bit)",
                     choices=("velocity", "hook_load"))
-    weight_on_bit: float = _pos("'hook_load': set weight on bit [N]", 25e3)
+    weight_on_bit: float = _pos("set weight on bit: a hook-load drive's, and an on-bottom start's [N]", 25e3)
+    start: str = key("auto", "initial state: 'off_bottom', 'on_bottom' (at weight_on_bit) or 'auto' (hook load in a well)",
+                     choices=("auto", "off_bottom", "on_bottom"))
     controller: str = key("stiff", "rotary drive: 'stiff' (theta_x(0) = Omega t), 'pi' or 'soft_torque' (top drive)",
                           choices=("stiff", "pi", "soft_torque"))
     top_drive_inertia: float = _pos("'pi', 'soft_torque': rotary inertia J_td of the top drive [kg m^2]", 500.0)
@@ -508,6 +510,14 @@ class Scene:
                                  f"with_changes({section}={{'key': value}})")
             raw.setdefault(section, {}).update(entries)
         return validate(raw)
+
+    @property
+    def starts_on_bottom(self) -> bool:
+        """Whether a run starts from the static state with ``drive.weight_on_bit`` on the bit: ``drive.start``, where
+        'auto' is on bottom for a hook-load drive in a well (the paper's horizontal string starts off bottom)."""
+        if self.drive.start != "auto":
+            return self.drive.start == "on_bottom"
+        return self.drive.mode == "hook_load" and bool(self.well.survey or self.well.md)
 
     def law(self, choice: str) -> str:
         """'consistent' or 'printed' for a per-law switch (``contact.axial_friction_law``, ...)."""

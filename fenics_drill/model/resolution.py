@@ -15,8 +15,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from fenics_drill.model.string_sections import section_at, string_sections
-from fenics_drill.model.well import well_of
+from fenics_drill.model.string_sections import string_sections
+from fenics_drill.model.well import hanging_tension
 
 #: Fewest displacement nodes (elements x degree) per flexural wavelength at f_max for the band to be carried
 #: within about 10 %.
@@ -45,22 +45,6 @@ def flexural_wavelength(properties, frequency_hz: float, tension=0.0):
 TENSION_SAMPLES = 2
 
 
-def hanging_tension(scene, md: np.ndarray) -> np.ndarray:
-    """The effective tension [N] at measured depths ``md`` of the string hanging in its well (a string of sections
-    on a survey): the buoyed weight below each point along the axis, less the weight on bit ``modal.weight_on_bit``
-    (Lubinski's effective tension without wall friction).  Zero in the straight horizontal hole."""
-    if not (scene.well.survey or scene.well.md) or not scene.model.gravity:
-        return np.zeros_like(md)
-    sections = string_sections(scene)
-    trajectory = well_of(scene, sections[-1].bottom).trajectory
-    fine = np.linspace(0.0, sections[-1].bottom, max(2001, 4 * scene.beam.elements + 1))
-    weight = np.array([s.buoyed_weight(scene.environment.gravity, scene.fluid.density, scene.inner_fluid_density)
-                       for s in sections])[section_at(sections, fine)]
-    along = weight * np.cos(trajectory.inclination(fine))  # the weight's component down the axis [N/m]
-    below = np.concatenate([np.cumsum((0.5 * (along[1:] + along[:-1]) * np.diff(fine))[::-1])[::-1], [0.0]])
-    return np.interp(md, fine, below) - scene.modal.weight_on_bit
-
-
 def nodes_per_wavelength(scene) -> float:
     """Displacement nodes of the mesh (elements x degree over the length) per flexural wavelength at f_max, where
     it is the shortest: each section's pipe (its homogenised tool joints' bending stiffness included) under the
@@ -71,7 +55,7 @@ def nodes_per_wavelength(scene) -> float:
     p, f_max = scene.beam_properties, band_frequency(scene)
     if not scene.string.sections:
         md = np.linspace(0.0, length, TENSION_SAMPLES * b.elements + 1)
-        return float(np.min(flexural_wavelength(p, f_max, hanging_tension(scene, md)))) / spacing
+        return float(np.min(flexural_wavelength(p, f_max, hanging_tension(scene, md, scene.modal.weight_on_bit)))) / spacing
     sections = string_sections(scene)
     shortest = np.inf
     for s in sections:
@@ -79,7 +63,8 @@ def nodes_per_wavelength(scene) -> float:
                        density=s.mass_per_length / (math.pi * (s.outer_radius**2 - s.inner_radius**2)),
                        inertia_stiffness_factor=s.stiffness_factors[1])
         md = np.linspace(s.top, s.bottom, max(2, math.ceil(TENSION_SAMPLES * b.elements * (s.bottom - s.top) / length)))
-        shortest = min(shortest, float(np.min(flexural_wavelength(pipe, f_max, hanging_tension(scene, md)))))
+        shortest = min(shortest, float(np.min(flexural_wavelength(pipe, f_max,
+                                                                   hanging_tension(scene, md, scene.modal.weight_on_bit)))))
     return shortest / spacing
 
 

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fenics_drill.model.discretization import THETA_X, U
+from fenics_drill.model.well import hanging_tension
 
 AXIAL, ROTATION = 0, 1
 
@@ -63,12 +64,14 @@ def controller_gains(drive, properties) -> tuple[float, float]:
 class TopDrive:
     """The drive of a scene in a solution space: multiplier rows for what it holds, loads for the rest."""
 
-    def __init__(self, drive, disc, space):
+    def __init__(self, drive, disc, space, top_force: float = 0.0):
+        """``top_force``: the axial force applied at the top when the drive leaves it free (``drive.mode =
+        'hook_load'``), along x (down-hole), N: minus the hook load (:meth:`from_scene`)."""
         self.rows = space.point_rows([disc.end_dof(U, 0), disc.end_dof(THETA_X, 0)])  # q -> u(0), theta_x(0)
         self.top = self.rows.subset([1])  # q -> theta_x(0)
         self.rate = np.array([drive.axial_velocity, drive.rotation_speed])  # V0, Omega
         self.held = np.array([drive.mode == "velocity", drive.controller == "stiff"])
-        self.weight_on_bit = drive.weight_on_bit
+        self.top_force = top_force
         self.inertia = 0.0 if self.held[ROTATION] else drive.top_drive_inertia
         self.gains = controller_gains(drive, disc.properties)
         self.torque_limit = drive.torque_limit
@@ -79,7 +82,14 @@ class TopDrive:
 
     @classmethod
     def from_scene(cls, scene, disc, space) -> "TopDrive":
-        return cls(scene.drive, disc, space)
+        """The scene's drive.  A hook-load drive holds the string with the hook load that leaves
+        ``drive.weight_on_bit`` on the bit: H = int_0^L w cos(I) ds - W_set, the buoyed weight along the axis less the
+        weight on bit (:func:`~fenics_drill.model.well.hanging_tension` at the top, no wall friction); its top force
+        is -H.  In the straight horizontal hole the weight has no share along the axis, and the top pushes with
+        W_set."""
+        top_force = -float(hanging_tension(scene, [0.0], scene.drive.weight_on_bit)[0]) \
+            if scene.drive.mode == "hook_load" else 0.0
+        return cls(scene.drive, disc, space, top_force)
 
     # --- what the multipliers hold -------------------------------------------------------------------------
 
@@ -149,7 +159,7 @@ class TopDrive:
                 self._no_loads = DriveLoads(np.zeros(len(q)), 0.0, 0.0)
                 self._no_loads.generalised.flags.writeable = False
             return self._no_loads
-        force = 0.0 if self.held[AXIAL] else self.weight_on_bit
+        force = 0.0 if self.held[AXIAL] else self.top_force
         torque = d_angle = d_speed = 0.0
         if not self.held[ROTATION]:
             angle, speed = self._top(q), self._top(qd)
@@ -161,10 +171,10 @@ class TopDrive:
 
     def constant_loads(self, size: int) -> np.ndarray | None:
         """The generalised loads of :meth:`evaluate` where they do not depend on the state (the rotation held: no
-        load, or the weight on bit of a hook load), else None (a speed controller's torque)."""
+        load, or the top force of a hook load), else None (a speed controller's torque)."""
         if not self.held[ROTATION]:
             return None
-        return np.zeros(size) if self.held.all() else self.rows.spread(np.array([self.weight_on_bit, 0.0]))
+        return np.zeros(size) if self.held.all() else self.rows.spread(np.array([self.top_force, 0.0]))
 
     def tangent(self, loads: DriveLoads, c_u: float, c_v: float):
         """c_u df/dq + c_v df/dqd of the applied loads (None when the drive holds everything)."""

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fenics_drill.model.string_sections import section_at, string_sections
 from fenics_drill.scene import SceneError, read_regular_file
 
 #: Largest dogleg a pipe can pass in a well [deg per 30 m]: beyond this a survey is refused as a typing error
@@ -385,3 +386,33 @@ def well_of(scene, string_length: float) -> Well:
                          f"is {trajectory.stations[k, 2]:.4g} m above the ground; check the inclinations (above 90 "
                          "deg the hole climbs)")
     return Well(trajectory, HoleSections(bottoms, radii, cased))
+
+
+def hanging_tension(scene, md, weight_on_bit: float) -> np.ndarray:
+    """The effective tension [N] at measured depths ``md`` of the scene's string hanging in its well with
+    ``weight_on_bit`` on the bit: the buoyed weight below each point along the axis, less the weight on bit
+    (Lubinski's effective tension, without wall friction).  In the straight horizontal hole, or without gravity, the
+    weight has no share along the axis: -weight_on_bit."""
+    md = np.asarray(md, dtype=float)
+    if not (scene.well.survey or scene.well.md) or not scene.model.gravity:
+        return np.full_like(md, -weight_on_bit)
+    sections = string_sections(scene)
+    trajectory = well_of(scene, sections[-1].bottom).trajectory
+    fine = np.linspace(0.0, sections[-1].bottom, max(2001, 4 * scene.beam.elements + 1))
+    weight = np.array([s.buoyed_weight(scene.environment.gravity, scene.fluid.density, scene.inner_fluid_density)
+                       for s in sections])[section_at(sections, fine)]
+    along = weight * np.cos(trajectory.inclination(fine))  # the weight's component down the axis [N/m]
+    below = np.concatenate([np.cumsum((0.5 * (along[1:] + along[:-1]) * np.diff(fine))[::-1])[::-1], [0.0]])
+    return np.interp(md, fine, below) - weight_on_bit
+
+
+def check_weight_on_bit(scene) -> None:
+    """Refuse a weight on bit that the string's weight in a well cannot give (SceneError with the numbers): the hook
+    would have to push it down.  The paper's horizontal string is pushed by design and is not checked."""
+    if not (scene.well.survey or scene.well.md) or not (scene.starts_on_bottom or scene.drive.mode == "hook_load"):
+        return
+    available = float(hanging_tension(scene, [0.0], 0.0)[0])
+    if scene.drive.weight_on_bit >= available:
+        raise SceneError(f"drive.weight_on_bit = {scene.drive.weight_on_bit:g} N is not admissible: the string's "
+                         f"buoyed weight along this well is {available:.6g} N, so the hook would have to push to set "
+                         "it; lower the weight on bit, or add collars or heavy-weight pipe")

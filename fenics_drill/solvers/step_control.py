@@ -32,7 +32,11 @@ from fenics_drill.model.reduction.spaces import column_bound, stack_rows
 from fenics_drill.scene import SceneError
 
 
-class StepTooSmall(RuntimeError):
+class RunFailure(RuntimeError):
+    """A run that cannot go on: it ends "failed" with this message (when and why)."""
+
+
+class StepTooSmall(RunFailure):
     """The step would have to go below dt_nominal / 2^max_step_cuts."""
 
 

@@ -20,7 +20,17 @@ from fenics_drill.model.reduction.hyper_reduction import CHECK_INTERVAL
 from fenics_drill.solvers.energy_budget import EnergyBudget, PowerTerms
 from fenics_drill.solvers.impacts import ImpactCounter
 from fenics_drill.solvers.newmark import NewmarkNewton, NewtonFailure, State
-from fenics_drill.solvers.step_control import StepController
+from fenics_drill.solvers.step_control import RunFailure, StepController
+
+
+#: A string whose top moves axially faster than this many times the set rate V0 (and than RUNAWAY_FLOOR) under a
+#: hook-load drive falls or is pulled out: the hook load does not hold it, and the run ends "failed".
+RUNAWAY_FACTOR = 100.0
+RUNAWAY_FLOOR = 0.5  # [m/s], 1800 m/h: faster than any drilling
+
+
+class Runaway(RunFailure):
+    """The top of a string held by its hook load moves far faster than the set rate: it falls or runs away."""
 
 
 @dataclass
@@ -105,8 +115,23 @@ class Simulation:
             self.stepper.forget_tangent()
         self._next_sampling_check = CHECK_INTERVAL * (np.floor(state.t / CHECK_INTERVAL + 1e-9) + 1)
 
+    def _check_top(self, state: State) -> None:
+        """Raise Runaway where the drive leaves the top free axially (a hook load) and it moves faster than
+        RUNAWAY_FACTOR times the set rate V0 (at least RUNAWAY_FLOOR)."""
+        drive = self.model.drive
+        if drive.held[0]:
+            return
+        speed = drive.velocities(state.qd)[0]
+        limit = max(RUNAWAY_FACTOR * abs(drive.rate[0]), RUNAWAY_FLOOR)
+        if abs(speed) > limit:
+            way = "falls" if speed > 0 else "is pulled out of the hole"
+            raise Runaway(f"at t = {state.t:.4g} s the top moves at {speed:.3g} m/s ({speed * 3600:.4g} m/h), more "
+                          f"than {limit:.3g} m/s: the string {way}; the hook load {-drive.top_force / 1e3:.4g} kN "
+                          "does not hold it (check drive.weight_on_bit and the bit's law)")
+
     def run(self, state: State, t_end: float, on_step=None, progress=None, atomic=contextlib.nullcontext) -> State:
-        """Step from ``state`` to t_end; raises StepTooSmall (with when and why) if the step collapses.
+        """Step from ``state`` to t_end; raises StepTooSmall (with when and why) if the step collapses, Runaway if a
+        string held by its hook load falls.
 
         ``on_step`` sees the initial state (step_index 0) and then every accepted step.  Each step (its Newton
         solve, its acceptance, the budget's and the memories' updates, ``on_step``) runs inside ``atomic()``: a
@@ -159,6 +184,7 @@ class Simulation:
                 state, ev, powers = new, new_ev, new_powers
                 self.last_state = state
                 self._check_sample(state)
+                self._check_top(state)
                 if on_step is not None:
                     on_step(StepRecord(state, dt, iterations, ev, impacts, self.impacts.in_contact.copy(), budget,
                                        self.stats["steps"]))

@@ -17,6 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from fenics_drill.model.drillstring import DrillstringModel, build_model
+from fenics_drill.model.forces.axial_tip_load import AxialTipLoad
+from fenics_drill.model.well import check_weight_on_bit
 from fenics_drill.model.reduction.enrichment import (basis_error, bit_loads, missed_share, tangent_responses,
                                                      wall_friction_loads)
 from fenics_drill.model.reduction.hyper_reduction import train_sample
@@ -25,7 +27,7 @@ from fenics_drill.model.reduction.spaces import ModalSpace
 from fenics_drill.observables.drilling_quantities import bit_bounce, drilling_quantities, stick_slip
 from fenics_drill.observables.step_rows import StepRows
 from fenics_drill.solvers.static import StaticEquilibrium, StaticFailure, solve_static, static_report
-from fenics_drill.solvers.step_control import StepTooSmall
+from fenics_drill.solvers.step_control import RunFailure
 from fenics_drill.solvers.time_loop import Simulation
 from fenics_drill.studies.lifecycle import uninterrupted
 from fenics_drill.studies.operating_state import prestressed_modes
@@ -55,7 +57,11 @@ def prepare(scene, dynamics: bool = True, stage=lambda name: None) -> PreparedSc
     The basis's directions above the band are damped as they are with the string resting at that equilibrium
     (:meth:`~fenics_drill.model.drillstring.DrillstringModel.resting_at`).
     With ``dynamics`` and ``reduction.hyper``, a modal model's nonlinear forces are then sampled
-    (:func:`_with_element_sample`).  ``stage(name)`` is told each part as it starts (a progress report)."""
+    (:func:`_with_element_sample`).  ``stage(name)`` is told each part as it starts (a progress report).
+    A scene that starts on bottom (:attr:`~fenics_drill.scene.Scene.starts_on_bottom`) rests with the bit pressed at
+    ``drive.weight_on_bit`` (an axial load at the bit in the static solve); its static report's hook load is then
+    the on-bottom one."""
+    check_weight_on_bit(scene)
     clock = time.perf_counter()
     stage("mesh, operators, modes and the reduced basis")
     model = build_model(scene, prestressed_modes(scene))
@@ -67,10 +73,13 @@ def prepare(scene, dynamics: bool = True, stage=lambda name: None) -> PreparedSc
         if state is not None:
             initial = model.space.phi.T @ (model.operators.mass @ state)  # M-orthonormal basis: the projection
     setup = time.perf_counter() - clock
-    stage("the static equilibrium on the wall")
-    equilibrium = solve_static(model, initial=initial)
+    on_bottom = scene.drive.weight_on_bit if scene.starts_on_bottom else 0.0
+    stage("the static equilibrium on the wall" + (f", the bit pressed at {on_bottom / 1e3:.4g} kN" if on_bottom else ""))
+    resting = model if not on_bottom else model.with_added_force(AxialTipLoad(model.disc, model.space, on_bottom))
+    equilibrium = solve_static(resting, initial=initial)
     model = model.resting_at(equilibrium.q)
-    static = {k: v for k, v in static_report(model, equilibrium).items() if k != "contact_vertices"}
+    static = {k: v for k, v in static_report(resting, equilibrium).items() if k != "contact_vertices"}
+    static["weight_on_bit"] = on_bottom
     if dynamics and scene.reduction.hyper and isinstance(model.space, ModalSpace) \
             and isinstance(model.internal, AssembledInternalForce):
         stage(f"the element sample of the nonlinear forces (training run of {scene.reduction.hyper_training:g} s)")
@@ -106,7 +115,7 @@ def _with_element_sample(model: DrillstringModel, scene, equilibrium: StaticEqui
             simulation.run(simulation.initial_state(equilibrium.q), horizon,
                            lambda r: states.append((r.state.q, r.state.qd, r.state.qdd)))
             break
-        except StepTooSmall as failure:
+        except RunFailure as failure:
             message = f"training run failed, all elements kept: {failure}"
     else:
         model.hyper_reduction = {"elements": None, "message": message}
@@ -226,7 +235,7 @@ def run_realisation(prepared: PreparedScene, scene) -> dict:
     status, message = "finished", "reached time.t_end"
     try:
         simulation.run(start, scene.time.t_end, recorder, atomic=uninterrupted)  # a signal stops it between steps
-    except StepTooSmall as failure:
+    except RunFailure as failure:
         status, message = "failed", str(failure)
     series = {k: np.asarray(v, dtype=float) for k, v in recorder.series.items()}
     t = series["time"]

@@ -35,7 +35,7 @@ from fenics_drill.observables.whirl import whirl
 from fenics_drill.scene import Time
 from fenics_drill.solvers.static import StaticFailure, static_report
 from fenics_drill.model.resolution import band_frequency, mesh_advice
-from fenics_drill.solvers.step_control import (StepTooSmall, check_run_length, least_steps, nominal_step,
+from fenics_drill.solvers.step_control import (RunFailure, check_run_length, least_steps, nominal_step,
                                               steps_per_band_period)
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
 from fenics_drill.studies.lifecycle import StopOnSignal, command_output, uninterrupted
@@ -94,7 +94,8 @@ def run_static(scene, out: str | Path, overwrite: bool = False, progress: bool =
         finally:
             setup.close()
         model, equilibrium = prepared.model, prepared.equilibrium
-        report = static_report(model, equilibrium)
+        report = {**static_report(model, equilibrium), "hook_load": prepared.static["hook_load"],
+                  "weight_on_bit": prepared.static["weight_on_bit"]}
         report["reduced_size"] = model.size
         report["basis_guard"] = model.guard
         reasons = discretisation_reasons(scene, {"command": "static"})
@@ -304,7 +305,7 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
             try:
                 final = simulation.run(start, scene.time.t_end, recorder, Progress(progress), atomic=atomic)
                 summary["status"], summary["message"] = "finished", "reached time.t_end"
-            except StepTooSmall as failure:
+            except RunFailure as failure:
                 final = None
                 summary["message"] = str(failure)
             summary["integration_time_s"] = time.perf_counter() - loop_clock

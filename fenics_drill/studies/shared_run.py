@@ -19,7 +19,7 @@ import numpy as np
 
 from fenics_drill.model.internal_force import AssembledInternalForce
 from fenics_drill.solvers.static import StaticFailure
-from fenics_drill.solvers.step_control import StepTooSmall
+from fenics_drill.solvers.step_control import RunFailure
 from fenics_drill.solvers.time_loop import Simulation
 from fenics_drill.studies.lifecycle import StopOnSignal, uninterrupted
 from fenics_drill.studies.prepare import prepare
@@ -81,7 +81,7 @@ def second_rank_run(scene, comm, refused: str | None) -> dict:
             check_same_state(comm, start.q)
             simulation.run(start, scene.time.t_end, atomic=lambda: uninterrupted(comm=comm))
             summary.update(status="finished", message="reached time.t_end")
-        except StepTooSmall as failure:
+        except RunFailure as failure:
             summary["message"] = str(failure)
         except StaticFailure as failure:
             summary["message"] = f"at t = 0 s: {failure}"
