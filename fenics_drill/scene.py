@@ -626,6 +626,10 @@ def _coerce(name: str, value: Any, kind: type, meta) -> Any:
     elif kind is tuple:
         if not isinstance(value, (list, tuple)):
             raise bad
+        if name != "string.sections" and re.search(r"\[[^\[\]]+\]", meta["doc"]):
+            # a list of quantities may write each with its unit, e.g. ["12.25 in", ...]
+            value = [with_unit(f"{name}[{k}]", v, meta["doc"]) if isinstance(v, str) else v
+                     for k, v in enumerate(value, start=1)]
         value = tuple(value)
     elif not isinstance(value, kind):
         raise bad

@@ -51,6 +51,8 @@ def to_si(text: str, unit: str) -> float:
     import pint
 
     units = registry()
+    if not re.search(r"\d", text):
+        raise UnitError(f"expected a number, or a number with its unit (e.g. '120 rpm', '5 in'), got {text!r}")
     try:
         quantity = units.Quantity(text.strip())
     except pint.UndefinedUnitError as err:

@@ -10,6 +10,7 @@ PACKAGE = Path(__file__).parents[1] / "fenics_drill"
 LAYERS = {
     "fenics_drill.forms": 0,
     "fenics_drill.scene": 1,
+    "fenics_drill.units": 1,  # the units a scene's values are written in: read with the scene
     "fenics_drill.model": 2,
     "fenics_drill.solvers": 3,
     "fenics_drill.observables": 4,

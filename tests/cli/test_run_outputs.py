@@ -87,7 +87,8 @@ def test_sigterm_ends_a_run_like_ctrl_c_and_keeps_its_results(tmp_path):
     import sys
     import time
 
-    long_run = ["time.t_end=1000" if a.startswith("time.t_end") else a for a in SHORT]
+    # a run far longer than the test waits for (more steps than time.max_steps allows unasked: asked for here)
+    long_run = ["time.t_end=1000" if a.startswith("time.t_end") else a for a in SHORT] + ["--set", "time.max_steps=1e12"]
     process = subprocess.Popen([sys.executable, "-m", "fenics_drill.cli", "run", *long_run, "--quiet",
                                 "--out", str(tmp_path)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     deadline = time.time() + 120
