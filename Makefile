@@ -2,7 +2,7 @@
 PY := .venv/bin/python
 OUT ?= out
 
-.PHONY: setup docs demo demo-printed demo-as-printed reproduction test bench bench-ross campbell wells mc optimize stick-slip clean
+.PHONY: setup docs demo demo-printed demo-as-printed reproduction test bench bench-ross campbell wells drilling mc optimize stick-slip clean
 
 setup:
 	@bash scripts/bootstrap.sh
@@ -85,6 +85,21 @@ wells: setup
 	cp $(OUT)/well-vbh-static/static_loads.png docs/figures/static_loads_vbh.png
 	$(PY) benchmarks/torque_drag_wells.py
 	$(PY) benchmarks/fe_wells.py
+
+## Drilling your well (docs/drilling.md): the build-and-hold demo well from its survey to a stick-slip run on bottom,
+## each command of the page, and the page's figures copied into docs/figures (about 5 minutes).
+drilling: setup
+	$(PY) -m fenics_drill.cli scene demos/scenes/well_build_hold.toml > /dev/null
+	$(PY) -m fenics_drill.cli torque-drag demos/scenes/well_build_hold.toml --overwrite --out $(OUT)/bh-td
+	$(PY) -m fenics_drill.cli static demos/scenes/well_build_hold.toml --overwrite --out $(OUT)/bh-static
+	$(PY) -m fenics_drill.cli modal demos/scenes/well_build_hold.toml --overwrite --out $(OUT)/bh-modal
+	$(PY) -m fenics_drill.cli run demos/scenes/well_build_hold.toml --overwrite --out $(OUT)/bh-run
+	$(PY) -m fenics_drill.cli plot $(OUT)/bh-run --no-gif
+	cp $(OUT)/bh-static/static_loads.png docs/figures/drilling_static_loads.png
+	cp $(OUT)/bh-modal/modes.png docs/figures/drilling_modes.png
+	cp $(OUT)/bh-run/fig15_bit_rotation.png docs/figures/drilling_bit_rotation.png
+	cp $(OUT)/bh-run/torque_drag.png docs/figures/drilling_torque_drag.png
+	cp $(OUT)/bh-run/fig16b_orbit.png docs/figures/drilling_orbit.png
 
 ## The paper's Monte Carlo study (Section 6.11) at SAMPLES realisations on RANKS processes (with the default Coulomb
 ## friction each realisation of 10 s runs the full order, about 160 s on one core here).

@@ -1,4 +1,4 @@
-"""The public Python API (re-exported by ``fenics_drill``): what a notebook needs, one call each.
+"""The public Python API (re-exported by ``fenics_drill``): what a notebook needs, one call each::
 
     import fenics_drill as fd
     scene = fd.load_scene("demos/scenes/paper.toml", ["time.t_end=1"])

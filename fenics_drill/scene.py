@@ -191,7 +191,7 @@ class Solver:
 
 @dataclass(frozen=True)
 class Output:
-    section: float = key(-1.0, "x of the section whose lateral motion is recorded; -1: mid-length L/2 [m]",
+    section: float = key(-1.0, "x of the section watched; -1: L/2, or 30 m above the bit of a string of sections [m]",
                          lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for L/2)")
     field_interval: float = _nonneg("simulated time between XDMF field snapshots; 0: no fields [s]", 0.1)
     von_mises: bool = key(True, "record the maximum von Mises stress over the string at every step (Eq. 100)")
@@ -235,7 +235,8 @@ class Modal:
                             "modes, near f* = 0.3-0.5)")
     state: str = key("auto", "modes about: 'unloaded', 'static' (tension, wall springs) or 'auto' (static in a well)",
                      choices=("auto", "unloaded", "static"))
-    weight_on_bit: float = _nonneg("compression at the bit of that static state; 0: off bottom [N]", 0.0)
+    weight_on_bit: float = key(-1.0, "compression at the bit of that static state; -1: the run's start's [N]",
+                               lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for the run's)")
 
 
 @dataclass(frozen=True)
@@ -512,6 +513,14 @@ class Scene:
         return validate(raw)
 
     @property
+    def modal_weight_on_bit(self) -> float:
+        """The weight on bit of the static state the modes are linearised about [N]: ``modal.weight_on_bit``, or
+        (-1) the run's: ``drive.weight_on_bit`` for a run that starts on bottom, 0 off bottom."""
+        if self.modal.weight_on_bit >= 0:
+            return self.modal.weight_on_bit
+        return self.drive.weight_on_bit if self.starts_on_bottom else 0.0
+
+    @property
     def starts_on_bottom(self) -> bool:
         """Whether a run starts from the static state with ``drive.weight_on_bit`` on the bit: ``drive.start``, where
         'auto' is on bottom for a hook-load drive in a well (the paper's horizontal string starts off bottom)."""
@@ -656,8 +665,9 @@ def _check_relations(scene: Scene) -> Scene:
         raise SceneError(f"borehole.radius = {hole.radius!r} is not admissible: must be > beam.outer_radius = "
                          f"{beam.outer_radius!r} (the string must fit in the hole)")
     length = scene.string_length
-    if scene.output.section == -1.0:
-        scene = dataclasses.replace(scene, output=dataclasses.replace(scene.output, section=0.5 * length))
+    if scene.output.section == -1.0:  # the middle of the paper's string; the BHA of a string of sections
+        watched = length - min(BHA_WATCH, 0.5 * length) if scene.string.sections else 0.5 * length
+        scene = dataclasses.replace(scene, output=dataclasses.replace(scene.output, section=watched))
     if scene.output.section > length:
         what = "the string's length" if scene.string.sections else "beam.length"
         raise SceneError(f"output.section = {scene.output.section!r} is not admissible: "
@@ -719,6 +729,10 @@ def check_history_grid(scene: Scene) -> None:
 
 #: The heaviest drilling fluid admitted [kg/m^3]: above the densest muds and brines (about 2.6 SG).
 MAX_FLUID_DENSITY = 3000.0
+
+
+#: How far above the bit a string of sections is watched by default (output.section = -1): in its BHA [m].
+BHA_WATCH = 30.0
 
 
 def _check_well_keys(scene: Scene) -> None:

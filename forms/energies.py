@@ -25,22 +25,34 @@ from .section_polynomial import SectionPolynomial
 STRAIN_SLOTS = ("theta_x", "theta_y", "theta_z", "du", "dv", "dw", "dtheta_x", "dtheta_y", "dtheta_z")
 
 
-def axial_derivatives(U, axis: CurvedAxis | None = None) -> tuple:
+def axial_derivatives(U, axis: CurvedAxis | None = None, finite_spin: bool = False) -> tuple:
     """The derivatives along the axis of the displacement (u, v, w) and rotation (theta_x, theta_y, theta_z)
     vectors, as components in the axis' frame.  On a curved axis (Bishop frame, curvature (k2, k3)) the frame turns:
-    (a t + b d2 + c d3)' = (a' - k2 b - k3 c) t + (b' + k2 a) d2 + (c' + k3 a) d3 (docs/wells.md)."""
+    (a t + b d2 + c d3)' = (a' - k2 b - k3 c) t + (b' + k2 a) d2 + (c' + k3 a) d3 (docs/wells.md).
+
+    The spin theta_x enters the bending of a curved axis as k theta_x only while it is small: the section spun by
+    theta_x about the tangent sees the axis' curvature turned by theta_x, (k2, k3) -> (k2 cos + k3 sin,
+    -k2 sin + k3 cos), so with ``finite_spin`` the bending slots take the change of curvature
+    (k2 sin theta_x + k3 (1 - cos theta_x), k3 sin theta_x - k2 (1 - cos theta_x)): bounded and periodic in the spin,
+    k theta_x to first order.  The linear form (46) and its tangent at rest keep k theta_x (docs/wells.md,
+    "A string spinning in a curved hole")."""
     d = [U[i].dx(0) for i in range(6)]
     if axis is None:
         return tuple(d)
     k2, k3 = axis.curvature
+    if finite_spin:
+        sin, versine = ufl.sin(U[3]), 1.0 - ufl.cos(U[3])
+        spin_y, spin_z = k2 * sin + k3 * versine, k3 * sin - k2 * versine
+    else:
+        spin_y, spin_z = k2 * U[3], k3 * U[3]
     return (d[0] - k2 * U[1] - k3 * U[2], d[1] + k2 * U[0], d[2] + k3 * U[0],
-            d[3] - k2 * U[4] - k3 * U[5], d[4] + k2 * U[3], d[5] + k3 * U[3])
+            d[3] - k2 * U[4] - k3 * U[5], d[4] + spin_y, d[5] + spin_z)
 
 
-def strain_slots(U, axis: CurvedAxis | None = None) -> dict:
+def strain_slots(U, axis: CurvedAxis | None = None, finite_spin: bool = False) -> dict:
     """theta_x, theta_y, theta_z and the axial derivatives u', v', w', theta_x', theta_y', theta_z' (in the frame
-    of a curved ``axis``: :func:`axial_derivatives`)."""
-    return dict(zip(STRAIN_SLOTS, (U[3], U[4], U[5], *axial_derivatives(U, axis))))
+    of a curved ``axis``: :func:`axial_derivatives`, with its ``finite_spin``)."""
+    return dict(zip(STRAIN_SLOTS, (U[3], U[4], U[5], *axial_derivatives(U, axis, finite_spin))))
 
 
 #: Kinematics of the cross-section (docs/errata.md, "Kinematics (14)"):
@@ -166,7 +178,7 @@ def inertial_force(p: BeamProperties, psi, U, V, A, dx, inertial_nonlinearity: b
 def elastic_force(p: BeamProperties, psi, U, dx, geometric_nonlinearity: bool = True, kinematics: str = "objective",
                   weight=1.0):
     """dV/dU [psi] (= K(psi, U) - F_SE(psi), Eqs. 46, 49); ``weight`` as for :func:`inertial_force`."""
-    W = strain_energy_density(p, strain_slots(U, p.axis), geometric_nonlinearity, kinematics)
+    W = strain_energy_density(p, strain_slots(U, p.axis, geometric_nonlinearity), geometric_nonlinearity, kinematics)
     return ufl.derivative(weight * W * dx, U, psi)
 
 

@@ -113,7 +113,8 @@ class InternalForms:
             return weight * (density - linear_density if sampled else density) * dx
 
         kinetic = energies.kinetic_energy_density(p, U, V, inertial_nonlinearity, angular_velocity)
-        strain = energies.strain_energy_density(p, energies.strain_slots(U, p.axis), geometric_nonlinearity, kinematics)
+        strain = energies.strain_energy_density(p, energies.strain_slots(U, p.axis, geometric_nonlinearity),
+                                                geometric_nonlinearity, kinematics)
         if not sampled:
             residual = (inertial(inertial_nonlinearity) + elastic(geometric_nonlinearity)
                         + energies.damping_force(p, psi, V, dx))

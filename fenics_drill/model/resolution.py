@@ -55,7 +55,7 @@ def nodes_per_wavelength(scene) -> float:
     p, f_max = scene.beam_properties, band_frequency(scene)
     if not scene.string.sections:
         md = np.linspace(0.0, length, TENSION_SAMPLES * b.elements + 1)
-        return float(np.min(flexural_wavelength(p, f_max, hanging_tension(scene, md, scene.modal.weight_on_bit)))) / spacing
+        return float(np.min(flexural_wavelength(p, f_max, hanging_tension(scene, md, scene.modal_weight_on_bit)))) / spacing
     sections = string_sections(scene)
     shortest = np.inf
     for s in sections:
@@ -64,7 +64,7 @@ def nodes_per_wavelength(scene) -> float:
                        inertia_stiffness_factor=s.stiffness_factors[1])
         md = np.linspace(s.top, s.bottom, max(2, math.ceil(TENSION_SAMPLES * b.elements * (s.bottom - s.top) / length)))
         shortest = min(shortest, float(np.min(flexural_wavelength(pipe, f_max,
-                                                                   hanging_tension(scene, md, scene.modal.weight_on_bit)))))
+                                                                   hanging_tension(scene, md, scene.modal_weight_on_bit)))))
     return shortest / spacing
 
 

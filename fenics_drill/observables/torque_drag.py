@@ -3,7 +3,8 @@ per length, from a state's vertex values; the force and torque the drive applies
 
 Along each element between two vertices the axial force is E A eps (1 + u') with the Green-Lagrange stretch
 eps = u' + (u'^2 + v'^2 + w'^2) / 2 (on a well's curved axis, u' - k2 v - k3 w in the axis' frame) and the torque
-the model's torsional stiffness G J times theta_x' (:attr:`~fenics_drill.forms.properties.BeamProperties.torsional_rigidity`), from
+minus the model's torsional stiffness G J times theta_x'
+(:attr:`~fenics_drill.forms.properties.BeamProperties.torsional_rigidity`: positive in the drive's sense), from
 the vertex values (the element's mean strain); the wall's normal force at a vertex is its spring force
 k_FS1 delta + k_FS2 delta^3 (Eq. 17 without the damper) over the length the vertex stands for.
 """
@@ -33,7 +34,9 @@ def string_profiles(x, u, v, w, theta_x, properties, gap: float, stiffness_linea
     s = properties.stiffness_section
     # the force along the axis, dW/du' = E A eps (1 + u'), eps the Green-Lagrange stretch (what the top holds)
     axial = properties.young_modulus * s.area * (du + 0.5 * (du**2 + dv**2 + dw**2)) * (1.0 + du)
-    torque = properties.torsional_rigidity * dt
+    # the torque the string carries down-hole, positive in the drive's sense (the soft string's and the surface
+    # torque's sign): minus G J theta_x', the twist falling from the driven top to the resisting bit
+    torque = -properties.torsional_rigidity * dt
     delta = np.hypot(v, w) - (np.asarray(gap)[order] if np.ndim(gap) else gap)
     spring = np.where(delta > 0, stiffness_linear * delta + stiffness_cubic * delta**3, 0.0)
     tributary = np.concatenate([[h[0] / 2], 0.5 * (h[1:] + h[:-1]), [h[-1] / 2]])

@@ -211,7 +211,7 @@ class VonMisesProbe:
         p = disc.properties
         self.E, self.G = p.young_modulus, p.shear_modulus
         self.field = fem.Function(disc.V)
-        slots = strain_slots(self.field, p.axis)
+        slots = strain_slots(self.field, p.axis, geometric_nonlinearity)
         strains = green_lagrange_strains(slots, kinematics) if geometric_nonlinearity else linear_strains(slots)
         coefficients = [poly.terms.get(m, 0.0) for poly in strains for m in MONOMIALS]
         if disc.sections is not None:  # each cell's E, G and radius: its strains scaled to the section at the bit's

@@ -97,7 +97,7 @@ def torque_drag_figure(snapshots: FieldSnapshots, path: Path) -> Path | None:
     x_mid = 0.5 * (snapshots.x[1:] + snapshots.x[:-1])
     late = snapshots.times >= 0.5 * snapshots.times[-1]
     panels_ = [(x_mid, cells["axial_force"] / 1e3, "axial force [kN] (tension +)"),
-               (x_mid, cells["torque"] / 1e3, "torque [kN m]")]
+               (x_mid, cells["torque"] / 1e3, "torque [kN m] (the drive's sense +)")]
     if "wall_normal_force_per_length" in points:
         panels_.append((snapshots.x, points["wall_normal_force_per_length"] / 1e3, "wall normal force [kN/m]"))
     fig, axes = panels(len(panels_), 2.6)

@@ -71,12 +71,16 @@ def static_loads_figure(directory: Path) -> Path:
     fig, axes = plt.subplots(1, 2, figsize=(10, 7), sharey=True)
     axes[0].plot(profiles["axial_force"].values / 1e3, md_e, label="FE static state")
     axes[0].plot(profiles["soft_string_tension"].values / 1e3, md, "--", label="soft string, off bottom")
-    axes[1].plot(profiles["wall_force_per_length"].values, md, lw=1)
+    axes[1].plot(profiles["wall_force_per_length"].values, md, lw=0.5, color="0.7", label="at the vertices")
+    if "wall_force_per_length_smoothed" in profiles:
+        axes[1].plot(profiles["wall_force_per_length_smoothed"].values, md, lw=1.2, color="tab:blue",
+                     label="over 10 m (about a joint of pipe)")
+        axes[1].legend(fontsize=8, loc="lower right")
     _tension_axes(axes, profiles)
     lowest = float(min(profiles["axial_force"].min(), profiles["soft_string_tension"].min()))
     highest = float(max(profiles["axial_force"].max(), profiles["soft_string_tension"].max()))
     axes[0].set_xlim(min(1.5 * lowest, -0.2 * highest) / 1e3, 1.1 * max(highest, 1.0) / 1e3)
-    axes[1].set_xlabel("wall contact force [N/m] (at the vertices)")
+    axes[1].set_xlabel("wall contact force per length [N/m]")
     fig.suptitle("The FE string at rest in its well")
     return save_figure(fig, directory / "static_loads.png")
 
@@ -129,18 +133,19 @@ def picture_3d(report: dict, profiles, path: Path) -> Path:
     points = np.column_stack([profiles["north"].values, profiles["east"].values, -profiles["tvd"].values])
     force = profiles[f"wall_force_per_length_{name}"].values
     line = pv.lines_from_points(points)
-    label = f"wall force [N/m], {LABELS.get(name, name)}"
+    label = "wall force [N/m]"
     line[label] = np.concatenate([[force[0]], 0.5 * (force[1:] + force[:-1]), [force[-1]]])
     extent = float(np.ptp(points, axis=0).max())
     plotter = off_screen_plotter((1200, 900))
     plotter.add_mesh(line.tube(radius=0.006 * extent, n_sides=16), scalars=label, cmap="plasma",
-                     scalar_bar_args={"title": label, "vertical": True, "position_x": 0.86, "position_y": 0.25,
-                                      "height": 0.5})
+                     scalar_bar_args={"title": label, "vertical": True, "position_x": 0.74, "position_y": 0.25, "fmt": "%.0f",
+                                      "height": 0.5, "title_font_size": 14, "label_font_size": 12})
     plotter.add_mesh(pv.Plane(center=(points[:, 0].mean(), points[:, 1].mean(), 0.0), i_size=1.2 * extent,
                               j_size=1.2 * extent), color="tan", opacity=0.3)
     plotter.show_grid(xtitle="north [m]", ytitle="east [m]", ztitle="up [m]")
     plotter.view_vector((1.0, -1.2, 0.6), viewup=(0, 0, 1))
-    plotter.add_text(f"{report['well']['measured_depth_m']:.0f} m well (tube radius exaggerated)", font_size=10)
+    plotter.add_text(f"{report['well']['measured_depth_m']:.0f} m well, wall force {LABELS.get(name, name)} "
+                     "(tube radius exaggerated)", font_size=10)
     plotter.screenshot(str(path))
     plotter.close()
     return path

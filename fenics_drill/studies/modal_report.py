@@ -2,7 +2,7 @@
 
 The modes of (62) about the state ``modal.state`` says: the stiffness (46) of the unloaded string, or the tangent
 stiffness about the operation's static state (:mod:`fenics_drill.studies.operating_state`: the hanging tension,
-the weight on bit ``modal.weight_on_bit`` and the wall springs); 'auto' takes the static state in a well and the
+the weight on bit of ``modal.weight_on_bit`` (-1: the run's start, on or off bottom) and the wall springs); 'auto' takes the static state in a well and the
 unloaded string in the paper's straight hole.  Three spectra of the band B, one per set of end conditions a run
 meets: free-free (Eq. 62 as the paper solves it), held by the drive at the top with the bit off bottom, and held
 by the drive with the bit stuck (theta_x held at x = L).
@@ -84,7 +84,7 @@ def modal_report(scene) -> dict:
     operators = assemble_linear(disc)
     loaded, about = None, {"state": "unloaded"}
     if linearised_state(scene) == "static":
-        state = operating_state(scene, disc, operators, scene.modal.weight_on_bit, on_wall=True)
+        state = operating_state(scene, disc, operators, scene.modal_weight_on_bit, on_wall=True)
         loaded, about = loaded_stiffness(scene, disc, operators, state), state.about
     space, _, basis, guard, stuck = solution_space(scene, disc, operators,
                                                    None if loaded is None else lambda *_: loaded)

@@ -42,7 +42,7 @@ def operating_state(scene, disc, operators, weight_on_bit: float, on_wall: bool)
     holds the top (u and theta_x at x = 0), the bit is free axially (the weight on bit is a load, not a support)."""
     switches = {"gravity": on_wall and scene.model.gravity, "contact": on_wall and scene.model.contact,
                 "bit_rock": False}
-    at_rest = scene.with_changes(model=switches)
+    at_rest = scene.with_changes(model=switches, drive={"mode": "velocity"})  # at rest the drive holds the top
     model = DrillstringModel(at_rest, disc, FullSpace(disc), operators)
     if weight_on_bit != 0:
         model = model.with_added_force(AxialTipLoad(disc, model.space, weight_on_bit))
@@ -83,12 +83,12 @@ def linearised_state(scene) -> str:
 def prestressed_modes(scene):
     """What the reduced basis's modes are solved with: None (the stiffness (46)) for an unloaded
     ``modal.state``, else ``(disc, operators) -> K`` of the string prestressed by its static state
-    (:func:`loaded_stiffness` about :func:`operating_state` with ``modal.weight_on_bit``)."""
+    (:func:`loaded_stiffness` about :func:`operating_state` with the scene's ``modal_weight_on_bit``)."""
     if linearised_state(scene) == "unloaded":
         return None
 
     def stiffness(disc, operators):
-        state = operating_state(scene, disc, operators, scene.modal.weight_on_bit, on_wall=True)
+        state = operating_state(scene, disc, operators, scene.modal_weight_on_bit, on_wall=True)
         return loaded_stiffness(scene, disc, operators, state)
 
     return stiffness

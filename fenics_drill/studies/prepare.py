@@ -63,7 +63,7 @@ def prepare(scene, dynamics: bool = True, stage=lambda name: None) -> PreparedSc
     the on-bottom one."""
     check_weight_on_bit(scene)
     clock = time.perf_counter()
-    stage("mesh, operators, modes and the reduced basis")
+    stage("mesh, operators, modes and the solution space (a reduced basis or the full order)")
     model = build_model(scene, prestressed_modes(scene))
     initial = None
     if isinstance(model.space, ModalSpace) and scene.reduction.enrich and scene.model.gravity:

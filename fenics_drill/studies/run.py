@@ -297,9 +297,10 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
             recorder = RunRecorder(model, scene, out, on_write=running)
             u0 = model.bit_state(start.q, start.qd)[0]
             summary["nominal_dt"] = nominal_step(scene)
-            if progress:  # the length of the run before it starts (the progress line's estimate follows)
-                sys.stderr.write(f"  {scene.time.t_end:g} s at a step of at most {summary['nominal_dt']:.3g} s: at "
-                                 f"least {least_steps(scene):.0f} steps\n")
+            if progress:  # the space it runs in and its length before it starts (the progress line's estimate follows)
+                space = "the full order" if model.space.sparse else "a reduced model"
+                sys.stderr.write(f"  {space}, {model.size} unknowns; {scene.time.t_end:g} s at a step of at most "
+                                 f"{summary['nominal_dt']:.3g} s: at least {least_steps(scene):.0f} steps\n")
                 sys.stderr.flush()
             loop_clock = time.perf_counter()
             try:

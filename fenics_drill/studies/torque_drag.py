@@ -166,6 +166,8 @@ def fe_static_profiles(scene, model, q):
     return xarray.Dataset(
         {"axial_force": ("md_element", loads["axial_force"]), "torque": ("md_element", loads["torque"]),
          "wall_force_per_length": ("md", loads["wall_normal_force_per_length"]),
+         "wall_force_per_length_smoothed": ("md", smoothed_per_length(x, loads["wall_normal_force_per_length"],
+                                                                      WALL_FORCE_WINDOW)),
          "sinusoidal_buckling_load": ("md_element", sinusoidal_load(stiffness, weight, inclination, clearance,
                                                                     curvature)),
          "helical_buckling_load": ("md_element", helical_load(stiffness, weight, inclination, clearance, curvature)),
@@ -173,6 +175,23 @@ def fe_static_profiles(scene, model, q):
          "north": ("md", position[:, 0]), "east": ("md", position[:, 1]), "tvd": ("md", -position[:, 2]),
          "lateral_displacement": ("md", np.hypot(fields[1], fields[2]))},
         coords={"md": x, "md_element": middle})
+
+
+#: The length over which the FE wall force is averaged for reading [m]: about a joint of pipe, over which a stiff
+#: string touches at its tool joints and spans between them (the soft string spreads the same force evenly).
+WALL_FORCE_WINDOW = 10.0
+
+
+def smoothed_per_length(x: np.ndarray, per_length: np.ndarray, window: float) -> np.ndarray:
+    """A force per length read at the vertices ``x`` (each standing for half its two elements), averaged over
+    ``window`` centred on each vertex (shortened at the ends): the force on the window over its length."""
+    h = np.diff(x)
+    nodal = per_length * np.concatenate([[h[0] / 2], 0.5 * (h[1:] + h[:-1]), [h[-1] / 2]])
+    cumulative = np.concatenate([[0.0], np.cumsum(nodal)])
+    low = np.searchsorted(x, x - window / 2, side="left")
+    high = np.searchsorted(x, x + window / 2, side="right")
+    span = np.minimum(x + window / 2, x[-1]) - np.maximum(x - window / 2, x[0])
+    return (cumulative[high] - cumulative[low]) / np.maximum(span, 1e-12)
 
 
 def write_torque_drag(scene, out: str | Path, overwrite: bool = False) -> dict:
