@@ -465,11 +465,14 @@ class TorqueDrag:
                             " and ".join(_OPERATIONS))
     friction_cased: float = _nonneg("friction coefficient in cased hole [-]", 0.25)
     friction_open: float = _nonneg("friction coefficient in open hole [-]", 0.30)
-    weight_on_bit: float = _nonneg("weight on bit while drilling [N]", 50e3)
+    weight_on_bit: float = key(-1.0, "weight on bit while drilling; -1: drive.weight_on_bit [N]",
+                               lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for the drive's)")
     torque_on_bit: float = _nonneg("torque on bit while drilling on bottom [N m]", 5e3)
-    rotation_speed: float = _nonneg("rotation speed while rotating [rad/s]", 2.0 * math.pi)
+    rotation_speed: float = key(-1.0, "rotation speed while rotating; -1: drive.rotation_speed [rad/s]",
+                                lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for the drive's)")
     trip_speed: float = _pos("axial speed while tripping [m/s]", 0.3)
-    rate_of_penetration: float = _nonneg("axial speed while drilling [m/s]", 20.0 / 3600.0)
+    rate_of_penetration: float = key(-1.0, "axial speed while drilling; -1: drive.axial_velocity [m/s]",
+                                     lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for the drive's)")
     element_length: float = _pos("length of the soft string's elements [m]", 10.0)
 
 
@@ -511,6 +514,16 @@ class Scene:
                                  f"with_changes({section}={{'key': value}})")
             raw.setdefault(section, {}).update(entries)
         return validate(raw)
+
+    @property
+    def set_points(self) -> dict:
+        """The operation's set points, one place for ``torque-drag`` and ``run``: the weight on bit [N], rotation
+        speed [rad/s] and rate of penetration [m/s] of [drive], unless [torque_drag] gives its own (-1: the drive's)."""
+        td, drive = self.torque_drag, self.drive
+        return {"weight_on_bit": td.weight_on_bit if td.weight_on_bit >= 0 else drive.weight_on_bit,
+                "rotation_speed": td.rotation_speed if td.rotation_speed >= 0 else abs(drive.rotation_speed),
+                "rate_of_penetration": td.rate_of_penetration if td.rate_of_penetration >= 0
+                else abs(drive.axial_velocity)}
 
     @property
     def modal_weight_on_bit(self) -> float:

@@ -39,14 +39,15 @@ class Operation:
 
 
 def operations(scene) -> list[Operation]:
-    """The operations ``torque_drag.operations`` names, with the study's speeds and bit loads.  Sliding drills with
+    """The operations ``torque_drag.operations`` names, with the scene's set points (:attr:`~fenics_drill.scene.Scene.
+    set_points`: the drive's, or the study's own) and torque on bit.  Sliding drills with
     a downhole motor: the bit's weight and the motor's reactive torque, carried by a string that does not turn."""
-    td = scene.torque_drag
+    td, sp = scene.torque_drag, scene.set_points
     table = {
-        "rotating_on_bottom": Operation("rotating_on_bottom", td.rate_of_penetration, td.rotation_speed,
-                                        -td.weight_on_bit, td.torque_on_bit),
-        "rotating_off_bottom": Operation("rotating_off_bottom", 0.0, td.rotation_speed, 0.0, 0.0),
-        "sliding": Operation("sliding", td.rate_of_penetration, 0.0, -td.weight_on_bit, td.torque_on_bit),
+        "rotating_on_bottom": Operation("rotating_on_bottom", sp["rate_of_penetration"], sp["rotation_speed"],
+                                        -sp["weight_on_bit"], td.torque_on_bit),
+        "rotating_off_bottom": Operation("rotating_off_bottom", 0.0, sp["rotation_speed"], 0.0, 0.0),
+        "sliding": Operation("sliding", sp["rate_of_penetration"], 0.0, -sp["weight_on_bit"], td.torque_on_bit),
         "tripping_in": Operation("tripping_in", td.trip_speed, 0.0, 0.0, 0.0),
         "tripping_out": Operation("tripping_out", -td.trip_speed, 0.0, 0.0, 0.0),
     }

@@ -37,8 +37,6 @@ bit_radius = "4.25 in"
 friction = 0.25
 
 [torque_drag]
-weight_on_bit = "40 kN"
-rotation_speed = "60 rpm"
 friction_open = 0.25
 element_length = 2.0
 
@@ -72,6 +70,16 @@ def well(tmp_path_factory):
     scene = fd.load_scene(path)
     soft = fd.torque_drag(scene).report["operations"]["rotating_on_bottom"]["hook_load_N"]
     return path, scene, soft
+
+
+def test_torque_drag_and_the_run_answer_the_same_question(well):
+    """One place holds the set points: the soft string drills with the drive's weight on bit, rotation speed and rate
+    of penetration unless [torque_drag] gives its own."""
+    _, scene, _ = well
+    assert scene.set_points == {"weight_on_bit": 40e3, "rotation_speed": pytest.approx(2 * np.pi, rel=1e-15),
+                                "rate_of_penetration": pytest.approx(1 / 180, rel=1e-15)}
+    own = scene.with_changes(torque_drag={"weight_on_bit": 30e3})
+    assert own.set_points["weight_on_bit"] == 30e3 and own.drive.weight_on_bit == 40e3
 
 
 def test_the_static_state_on_bottom_has_the_soft_strings_hook_load(well):
