@@ -3,7 +3,8 @@
 unit of its key (the ``[unit]`` of the key's meaning) when the scene is read.  A unit pint does not know, or one of
 another dimension than the key's, is refused in one line naming the key.
 
-Units besides pint's own: ``ppg`` (pound per US gallon, the mud weight's), ``sg`` (specific gravity, 1000 kg/m^3).
+Units besides pint's own: ``ppg`` (pound per US gallon, the mud weight's), ``sg`` (specific gravity, 1000 kg/m^3),
+``usft`` (the US survey foot of older surveys, 1200/3937 m).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import math
 import re
 
 #: The units the drilling world writes that pint's registry lacks.
-DRILLING_UNITS = ("ppg = pound / gallon", "sg = 1000 * kilogram / meter ** 3 = SG")
+DRILLING_UNITS = ("ppg = pound / gallon", "sg = 1000 * kilogram / meter ** 3 = SG", "usft = survey_foot")
 
 
 class UnitError(ValueError):

@@ -10,7 +10,6 @@ Coordinates: x north, y east, z up (true vertical depth is -z); the tangent poin
 from __future__ import annotations
 
 import csv
-import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +18,7 @@ import numpy as np
 
 from fenics_drill.model.string_sections import section_at, string_sections
 from fenics_drill.scene import SceneError, read_regular_file
+from fenics_drill.units import UnitError, to_si
 
 #: Largest dogleg a pipe can pass in a well [deg per 30 m]: beyond this a survey is refused as a typing error
 #: (the tightest short-radius wells build at about 2-3 deg per metre).
@@ -87,10 +87,8 @@ MAX_SURVEY_BYTES = 50_000_000
 SURVEY_COLUMNS = {"md": ("md", "measured depth", "measured_depth", "measureddepth", "depth"),
                   "inclination": ("inclination", "inc", "incl"),
                   "azimuth": ("azimuth", "azi", "az", "azim")}
-#: The units a header may give: to metres for md, to degrees for the angles.
-LENGTH_UNITS = {"": 1.0, "m": 1.0, "metre": 1.0, "metres": 1.0, "meter": 1.0, "meters": 1.0, "ft": 0.3048,
-                "feet": 0.3048, "foot": 0.3048, "usft": 1200.0 / 3937.0}
-ANGLE_UNITS = {"": 1.0, "deg": 1.0, "degree": 1.0, "degrees": 1.0, "°": 1.0, "rad": 180.0 / math.pi}
+#: What each survey column is read in: its header's unit (pint's, :mod:`fenics_drill.units`) converted to these.
+SURVEY_UNITS = {"md": "m", "inclination": "degree", "azimuth": "degree"}
 _UNIT = re.compile(r"^(?P<name>.*?)\s*[(\[]\s*(?P<unit>[^()\[\]]*?)\s*[)\]]\s*$")
 
 
@@ -121,11 +119,12 @@ def _survey_column(header: str, path: Path) -> tuple[str | None, float]:
     name, unit = " ".join(name.lower().split()), unit.strip().lower()
     for column, aliases in SURVEY_COLUMNS.items():
         if name in aliases:
-            units = LENGTH_UNITS if column == "md" else ANGLE_UNITS
-            if unit not in units:
-                raise SurveyError(f"survey file {path}: column {cell!r} has the unit {unit!r}, which is not one of "
-                                  f"{', '.join(u for u in units if u)}")
-            return column, units[unit]
+            if not unit:
+                return column, 1.0
+            try:
+                return column, to_si(f"1 {'degree' if unit == '°' else unit}", SURVEY_UNITS[column])
+            except UnitError as err:
+                raise SurveyError(f"survey file {path}: column {cell!r}: {err}") from None
     return None, 1.0
 
 

@@ -175,7 +175,8 @@ def test_the_api_checks_a_scene_changed_with_dataclasses_replace():
     (b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR", "is a binary file"),
     ("md,inclination,azimuth\n0,0,0\n", "at least two stations"),
     ("md,inclination,azimuth\n0,0,0\n40,0,0\n30,45,30\n", "does not exceed the station before"),
-    ("MD (yd),Inc (deg),Azi (deg)\n0,0,0\n40,0,0\n", "unit 'yd'"),
+    ("MD (furlongz),Inc (deg),Azi (deg)\n0,0,0\n40,0,0\n", "unknown unit 'furlongz'"),
+    ("MD (kg),Inc (deg),Azi (deg)\n0,0,0\n40,0,0\n", "is not a quantity in m"),
     ("md,inclination,azimuth\n0,0,0\n40,100,0\n120,150,0\n", "rises above the surface"),
 ])
 def test_malformed_surveys_are_refused_naming_the_line(tmp_path, capsys, survey, words):
