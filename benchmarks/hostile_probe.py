@@ -132,7 +132,7 @@ def survey_cases() -> list[Case]:
         "survey: tabs": ("md\tinclination\tazimuth\n0\t0\t0\n40\t0\t0\n120\t45\t30\n", True),
         "survey: an unknown unit": ("MD (furlongz),Inc (deg),Azi (deg)\n0,0,0\n40,0,0\n120,45,30\n", False),
         "survey: a unit of mass for the depth": ("MD (kg),Inc (deg),Azi (deg)\n0,0,0\n40,0,0\n120,45,30\n", False),
-        "survey: depths in yards": ("MD (yd),Inc (deg),Azi (deg)\n0,0,0\n43.74,0,0\n131.23,45,30\n", True),
+        "survey: depths in yards": ("MD (yd),Inc (deg),Azi (deg)\n0,0,0\n43.74,0,0\n131.24,45,30\n", True),
         "survey: a binary file": (b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\x00", False),
         "survey: empty": ("", False),
         "survey: a header only": ("md,inclination,azimuth\n", False),

@@ -128,6 +128,7 @@ def test_static_on_a_dense_survey_reports_its_stages(tmp_path):
     scene = well_scene(tmp_path, survey)
     result = tool("static", str(scene), "--out", str(tmp_path / "o"))
     assert result.returncode == 0 and "Traceback" not in result.stderr, result.stderr
+    assert "  set-up: " in result.stderr  # measured: 12 s, its stage said at 5 s
     report = json.loads((tmp_path / "o" / "static.json").read_text())
     assert report["hook_load"] > 0
 
