@@ -63,14 +63,16 @@ def _tension_axes(axes, profiles) -> None:
 
 def static_loads_figure(directory: Path) -> Path:
     """The FE static state along its well (``static_profiles.h5``): its effective tension against the soft string's
-    off bottom and the buckling loads as compression limits, its torque, and the wall's force per length."""
+    in the same operation and the buckling loads as compression limits, its torque, and the wall's force per
+    length."""
     import xarray
 
     profiles = xarray.load_dataset(directory / "static_profiles.h5", engine="h5netcdf")
     md, md_e = profiles["md"].values, profiles["md_element"].values
     fig, axes = plt.subplots(1, 2, figsize=(10, 7), sharey=True)
     axes[0].plot(profiles["axial_force"].values / 1e3, md_e, label="FE static state")
-    axes[0].plot(profiles["soft_string_tension"].values / 1e3, md, "--", label="soft string, off bottom")
+    operation = profiles.attrs.get("soft_string_operation", "rotating_off_bottom")
+    axes[0].plot(profiles["soft_string_tension"].values / 1e3, md, "--", label=f"soft string, {LABELS[operation]}")
     axes[1].plot(profiles["wall_force_per_length"].values, md, lw=0.5, color="0.7", label="at the vertices")
     if "wall_force_per_length_smoothed" in profiles:
         axes[1].plot(profiles["wall_force_per_length_smoothed"].values, md, lw=1.2, color="tab:blue",

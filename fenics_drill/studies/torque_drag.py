@@ -140,7 +140,8 @@ def fe_static_profiles(scene, model, q):
     """The FE static state ``q`` of a string in its well along measured depth, as an ``xarray.Dataset``: its axial
     force (the effective tension: the FE weighs the pipe in the mud) and torque on each element (``md_element``)
     with the sinusoidal and helical buckling loads there, its wall force per length at the vertices (``md``), and the
-    soft string's effective tension off bottom (no axial friction) for comparison; where each vertex lies (north,
+    soft string's effective tension in the same operation (off bottom, or rotating on bottom for a state on bottom)
+    for comparison; where each vertex lies (north,
     east, true vertical depth: the axis plus the lateral displacement) and how far it is off the axis."""
     import xarray
 
@@ -159,7 +160,8 @@ def fe_static_profiles(scene, model, q):
     clearance = np.minimum(model.vertex_gap[1:], model.vertex_gap[:-1])
     trajectory = disc.trajectory if disc.trajectory is not None else well_of(scene, disc.properties.length).trajectory
     inclination, curvature = trajectory.inclination(middle), trajectory.curvature(middle)
-    soft = torque_drag_study(scene.with_changes(torque_drag={"operations": ["rotating_off_bottom"]}))["profiles"]
+    operation = "rotating_on_bottom" if scene.starts_on_bottom else "rotating_off_bottom"  # what the state carries
+    soft = torque_drag_study(scene.with_changes(torque_drag={"operations": [operation]}))["profiles"]
     frames = trajectory.bishop_frames(x)
     lateral = fields[1][:, None] * frames.d2 + fields[2][:, None] * frames.d3
     position = trajectory.positions(x) + lateral  # where the string's axis lies in the hole
@@ -171,10 +173,10 @@ def fe_static_profiles(scene, model, q):
          "sinusoidal_buckling_load": ("md_element", sinusoidal_load(stiffness, weight, inclination, clearance,
                                                                     curvature)),
          "helical_buckling_load": ("md_element", helical_load(stiffness, weight, inclination, clearance, curvature)),
-         "soft_string_tension": ("md", np.interp(x, soft["md"].values, soft["tension_rotating_off_bottom"].values)),
+         "soft_string_tension": ("md", np.interp(x, soft["md"].values, soft[f"tension_{operation}"].values)),
          "north": ("md", position[:, 0]), "east": ("md", position[:, 1]), "tvd": ("md", -position[:, 2]),
          "lateral_displacement": ("md", np.hypot(fields[1], fields[2]))},
-        coords={"md": x, "md_element": middle})
+        coords={"md": x, "md_element": middle}, attrs={"soft_string_operation": operation})
 
 
 #: The length over which the FE wall force is averaged for reading [m]: about a joint of pipe, over which a stiff
