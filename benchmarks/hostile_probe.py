@@ -40,23 +40,11 @@ SMALL = ["--set", "beam.length=20", "--set", "beam.elements=40"]
 CLASSES = ("refused", "correct", "suspect", "failed (stated)", "bad input accepted", "unclear", "traceback", "hang",
            "data loss")
 
+# the 120 m string of collar and drill pipe in mud that the hostile-input tests use
+sys.path.insert(0, str(ROOT / "tests" / "cli"))
+from test_hostile_inputs import SECTIONS  # noqa: E402
+
 SURVEY = "md,inclination,azimuth\n0,0,0\n40,0,0\n120,45,30\n"
-SECTIONS = """
-[[string.sections]]
-name = "collar"
-length = 20.0
-outer_radius = 0.0857
-inner_radius = 0.0357
-{collar}
-[[string.sections]]
-name = "drill pipe"
-length = 100.0
-outer_radius = 0.0635
-inner_radius = 0.0543
-tool_joint_outer_radius = 0.084
-tool_joint_length = 0.45
-tool_joint_spacing = 9.4
-"""
 
 
 @dataclass

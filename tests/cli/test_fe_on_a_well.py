@@ -76,6 +76,7 @@ def test_run_modal_and_campbell_work_on_a_well(well_scene, tmp_path):
     assert modes["spectra"]["drive_held_bit_stuck"]["held"] == ["u(0)", "theta_x(0)", "theta_x(L)"]
     torsional = [m["frequency_hz"] for m in modes["spectra"]["drive_held_bit_off_bottom"]["modes"]
                  if m["kind"] == "torsional"]
+    # the period is 1 / f of the same float: round-off of one division
     assert modes["first_torsional_period_s"] == pytest.approx(1 / torsional[0], rel=1e-12)
     assert len(modes["lateral_critical_speeds_rpm"]) == 3
     assert (tmp_path / "modal" / "modes.png").stat().st_size > 0

@@ -205,6 +205,8 @@ def test_surveys_as_exported_are_read_as_the_plain_one(tmp_path, header, encodin
     path = tmp_path / "survey.csv"
     path.write_bytes(text.encode(encoding))
     survey = read_survey_csv(path)
+    # the depths went through repr() of md / factor and back times factor, the angles through degrees and radians:
+    # a few ulps of round-off, so 1e-12
     np.testing.assert_allclose(survey.md, [r[0] for r in rows], rtol=1e-12)
     np.testing.assert_allclose(np.degrees(survey.inclination), [r[1] for r in rows], rtol=1e-12)
 
@@ -320,6 +322,7 @@ def test_the_first_progress_line_gives_no_estimate_from_the_start_up(capsys):
 
 
 def test_the_manual_speaks_of_the_software_not_of_one_days_circumstances():
+    # phrases the manual once used for the conditions of one measurement; a table states its machine and command
     words = ("shared machine", "this project's machine", "the machine, not the code", "running on the other core")
     for page in (ROOT / "docs").rglob("*.md"):
         text = page.read_text().lower()

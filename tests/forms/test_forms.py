@@ -104,6 +104,7 @@ def test_stiffness_46_is_the_energys_tangent_in_each_torsion_and_with_homogenise
     numbers = disc.properties
     expected = (numbers.shear_factor if variant == "printed torsion" else numbers.inertia_stiffness_factor) * \
         numbers.shear_modulus * 2 * numbers.section.I4
+    # the same product of floats in another order: round-off
     assert numbers.torsional_rigidity == pytest.approx(expected, rel=1e-14)
     if variant == "tool joints":
         assert numbers.inertia_stiffness_factor > 1.04  # the joints stiffen the pipe (4.7 %): the case tests something

@@ -83,7 +83,7 @@ def test_torsional_free_free_frequencies(slender_modes):
     n = np.arange(1, len(f) + 1)
     c_T = st_venant_wave_speed(p)
     assert len(f) == int(2 * 2.2 * p.longitudinal_wave_speed / c_T)  # f* = n c_T/(2 c_L) <= 2.2
-    np.testing.assert_allclose(f, n * c_T / (2 * p.length), rtol=3e-4)
+    np.testing.assert_allclose(f, n * c_T / (2 * p.length), rtol=3e-4)  # (kh)^2 / 24 = 2.24e-4 at the 7th mode
 
 
 def test_printed_torsion_is_the_papers_shear_corrected_wave_speed():
@@ -96,7 +96,7 @@ def test_printed_torsion_is_the_papers_shear_corrected_wave_speed():
     f = family_frequencies(solve_modes(disc, 2.2), "torsional")
     n = np.arange(1, len(f) + 1)
     c_T = math.sqrt(p.shear_factor / (1 + p.poisson_ratio) / 2 * p.young_modulus / p.density)
-    np.testing.assert_allclose(f, n * c_T / (2 * p.length), rtol=3e-4)
+    np.testing.assert_allclose(f, n * c_T / (2 * p.length), rtol=3e-4)  # (kh)^2 / 24 = 2.24e-4 at the 7th mode
 
 
 def test_modes_held_by_the_drive_are_the_fixed_free_quarter_waves():
