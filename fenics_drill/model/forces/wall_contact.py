@@ -674,6 +674,25 @@ class WallContact:
         _, nodal, _, _ = _vertex_loads(positions, rates, *self._law())
         self._history = (positions, np.column_stack([nodal[:, 0], nodal[:, 3] / self.arm]))
 
+    def kept_on_wall(self, q_from: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """q with each vertex that touched the wall at ``q_from`` moved radially to the indentation it had there
+        (full space: its (v, w) rows select dofs): a Newmark predictor extrapolates along a straight line, off the
+        round wall."""
+        lateral = self.every.lateral_rows
+        before = (lateral @ q_from).reshape(-1, 2)
+        now = (lateral @ q).reshape(-1, 2)
+        r_before, r_now = np.hypot(*before.T), np.hypot(*now.T)
+        touching = (r_before > self.gap) & (r_now > 0.0)
+        scale = np.ones_like(r_now)
+        scale[touching] = r_before[touching] / r_now[touching]
+        columns, _ = _selection(lateral)
+        columns = columns.reshape(-1, 2)
+        out = q.copy()
+        for k in range(2):
+            free = columns[:, k] >= 0
+            out[columns[free, k]] *= scale[free]
+        return out
+
     def record(self, forces: "WallForces") -> dict[str, float]:
         return {"vertices_in_contact": int(np.count_nonzero(forces.delta > 0))}
 
