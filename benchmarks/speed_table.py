@@ -1,6 +1,6 @@
 """What runs cost before and after a revision, measured side by side in one session.
 
-    python benchmarks/speed_table.py [--before 50d35ac] [--runs out/speed] [--table benchmarks/results/speed.md]
+    python benchmarks/speed_table.py [--before 50d35ac] [--runs out/speed] [--table benchmarks/results/speed_against_revision.md]
 
 The revision ``--before`` is checked out with ``git worktree`` into RUNS/before-tree and run with the same
 interpreter as the working tree (its packages come first on sys.path), one run at a time on one core.
@@ -98,7 +98,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--before", default="50d35ac")
     parser.add_argument("--runs", type=Path, default=ROOT / "out/speed")
-    parser.add_argument("--table", type=Path, default=ROOT / "benchmarks/results/speed.md")
+    parser.add_argument("--table", type=Path, default=ROOT / "benchmarks/results/speed_against_revision.md")
     args = parser.parse_args()
     runs = args.runs.resolve()
     runs.mkdir(parents=True, exist_ok=True)
