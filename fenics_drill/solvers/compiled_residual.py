@@ -2,7 +2,7 @@
 
 :meth:`DrillstringModel.evaluate` runs each force's kernel from Python and sums their loads there; at the
 paper scene's two evaluations per step that glue costs about as much as the kernels (docs/performance.md).  :func:`residual_at` runs the same kernels (the sampled internal force of
-:mod:`~fenics_drill.model.kernels.cell_kernels`, the wall's :func:`~fenics_drill.model.forces.wall_contact._modal_pass`,
+:mod:`~fenics_drill.model.kernels.cell_kernels`, the wall's :func:`~fenics_drill.model.forces.wall.vertex_passes._modal_pass`,
 the bit law (20)-(22)) and the same sums, in the same order, for the compiled Newton step of
 :mod:`fenics_drill.solvers.compiled_step`.
 
@@ -20,7 +20,7 @@ from fenics_drill.model.kernels.cell_kernels import ASSEMBLE_CELLS_AT
 from fenics_drill.model.forces.bit_rock import LAW as BIT_LAW
 from fenics_drill.model.forces.bit_rock import BitRock
 from fenics_drill.model.forces.gravity import Gravity
-from fenics_drill.model.forces.wall_contact import MODAL_PASS as WALL_PASS
+from fenics_drill.model.forces.wall.vertex_passes import MODAL_PASS as WALL_PASS
 from fenics_drill.model.forces.wall_contact import WallContact
 from fenics_drill.model.internal_force import AssembledInternalForce
 from fenics_drill.model.reduction.out_of_band_damping import OutOfBandDamping

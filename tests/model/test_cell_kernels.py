@@ -9,7 +9,7 @@ from dolfinx import fem
 
 from fenics_drill.model.kernels.cell_kernels import CellAssembly
 from fenics_drill.model.discretization import BeamDiscretization
-from fenics_drill.model.forces.wall_contact import _contact_blocks, _modal_pass, _projected_laws, _vertex_loads
+from fenics_drill.model.forces.wall.vertex_passes import _contact_blocks, _modal_pass, _projected_laws, _vertex_loads
 from fenics_drill.model.internal_force import ElementSample, InternalForms, SampledCoefficients
 from fenics_drill.solvers.static import solve_static
 from fenics_drill.studies.prepare import prepare

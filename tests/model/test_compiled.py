@@ -7,7 +7,7 @@ import threading
 import numpy as np
 import pytest
 
-from fenics_drill.model.forces.wall_contact import _vertex_loads
+from fenics_drill.model.forces.wall.vertex_passes import _vertex_loads
 
 
 def interrupt(signum, frame):

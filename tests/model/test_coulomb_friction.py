@@ -11,7 +11,8 @@ import pytest
 
 from conftest import scene_with
 from fenics_drill.model.discretization import THETA_X, U, V, W
-from fenics_drill.model.forces.wall_contact import _contact_blocks, _vertex_loads, coulomb_friction
+from fenics_drill.model.forces.wall.coulomb import coulomb_friction
+from fenics_drill.model.forces.wall.vertex_passes import _contact_blocks, _vertex_loads
 from fenics_drill.observables.whirl import whirl
 from fenics_drill.studies.prepare import prepare
 from fenics_drill.solvers.time_loop import Simulation

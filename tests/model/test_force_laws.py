@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from fenics_drill.model.forces import bit_rock, wall_contact
+from fenics_drill.model.forces import bit_rock
+from fenics_drill.model.forces.wall import normal_force, paper_friction
 
 VELOCITIES = np.concatenate([-np.logspace(-6, 1, 50), [0.0], np.logspace(-6, 1, 50)])
 
@@ -12,10 +13,10 @@ def test_wall_friction_never_does_positive_work():
     """Over a sweep of u_dot, theta_x_dot of both signs and contact states, F_a u_dot <= 0 and T theta_x_dot <= 0."""
     delta = np.array([-1e-3, 0.0, 1e-6, 1e-4, 2e-3])[:, None]
     delta_rate = np.array([-0.5, 0.0, 0.5])[:, None, None]
-    normal = wall_contact.hunt_crossley_normal_force(delta, delta_rate, 1e10, 1e16, 1e6)
+    normal = normal_force.hunt_crossley_normal_force(delta, delta_rate, 1e10, 1e16, 1e6)
     assert np.all(normal <= 0)
     for vel in VELOCITIES:
-        force, torque = wall_contact.wall_friction(normal, vel, vel * 50, 0.25, 0.095, 1e-4)
+        force, torque = paper_friction.wall_friction(normal, vel, vel * 50, 0.25, 0.095, 1e-4)
         assert np.all(force * vel <= 0) and np.all(torque * vel * 50 <= 0)
 
 
@@ -31,11 +32,11 @@ def test_bit_rock_force_and_torque_never_do_positive_work():
 def test_hunt_crossley_damper_dissipates_and_has_force_units():
     """With c |delta|^3 delta_dot, c in N s / m^4 gives newtons; the damper opposes delta_dot."""
     c, delta, rate = 1e6, 1e-3, 0.1  # springs off to isolate the damper
-    approaching = wall_contact.hunt_crossley_normal_force(delta, rate, 0.0, 0.0, c)
+    approaching = normal_force.hunt_crossley_normal_force(delta, rate, 0.0, 0.0, c)
     assert approaching == pytest.approx(-c * delta**3 * rate, rel=1e-14)
     assert approaching * rate < 0
     # receding, the bare damper would pull towards the wall: the law clips it to zero
-    assert wall_contact.hunt_crossley_normal_force(delta, -rate, 0.0, 0.0, c) == 0.0
+    assert normal_force.hunt_crossley_normal_force(delta, -rate, 0.0, 0.0, c) == 0.0
 
 
 def test_printed_damper_grows_with_the_impact_speed_and_still_dissipates():
@@ -44,14 +45,14 @@ def test_printed_damper_grows_with_the_impact_speed_and_still_dissipates():
     c, rate = 1e6, np.array([-0.3, -1e-3, 0.0, 2e-2, 0.5])
     # the same arithmetic as the law, a few float operations apart: 1e-14 is round-off
     for delta in (1e-6, 1e-3):
-        force, by_delta, by_rate = wall_contact.hunt_crossley_damper(delta, rate, c, "printed")
+        force, by_delta, by_rate = normal_force.hunt_crossley_damper(delta, rate, c, "printed")
         np.testing.assert_allclose(force, -c * np.abs(rate) ** 3 * rate, rtol=1e-14)
         assert np.all(force * rate <= 0)
         np.testing.assert_allclose(by_delta, 0.0)
         np.testing.assert_allclose(by_rate, -4 * c * np.abs(rate) ** 3, rtol=1e-14)
     # at an impact of 0.5 m/s and 0.1 mm indentation the printed damper is 10^12 times the consistent one
-    printed = wall_contact.hunt_crossley_damper(1e-4, 0.5, c, "printed")[0]
-    consistent = wall_contact.hunt_crossley_damper(1e-4, 0.5, c, "consistent")[0]
+    printed = normal_force.hunt_crossley_damper(1e-4, 0.5, c, "printed")[0]
+    consistent = normal_force.hunt_crossley_damper(1e-4, 0.5, c, "consistent")[0]
     assert printed / consistent == pytest.approx(0.5**3 / 1e-12, rel=1e-12)  # a ratio of two products: round-off
 
 
@@ -61,7 +62,7 @@ def test_the_regularised_sign_is_tanh_to_the_last_bit_where_it_saturates_too():
     from LLVM's by an ulp, which is not what this checks)."""
     from numba import njit
 
-    sign = njit(lambda x, scale: wall_contact._regularised_sign(x, scale))
+    sign = njit(lambda x, scale: paper_friction._regularised_sign(x, scale))
     tanh = njit(lambda x, scale: np.tanh(x / scale))
     ratios = np.concatenate(([0.0], np.geomspace(1e-3, 1e300, 20000)))
     for x in np.concatenate((ratios, -ratios)) * 1e-3:
