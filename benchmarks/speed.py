@@ -66,6 +66,17 @@ def machine_unit(repeats: int = 7) -> float:
     return float(np.median(times))
 
 
+def processor() -> str:
+    """The CPU's model name, as the kernel reports it."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "CPU not reported"
+
+
 def run(scene: Path, settings: tuple, t_end: float, tolerance: float | None = None) -> dict:
     """One `fenics-drill run` in its own process: its summary, the whole run's wall time and its peak memory."""
     with tempfile.TemporaryDirectory() as out:
@@ -131,7 +142,7 @@ def main() -> None:
         "# What the default runs cost", "",
         f"Command: `python benchmarks/speed.py --rows {' '.join(args.rows)} --reference-rows "
         f"{' '.join(args.reference_rows)} --workers {args.workers}`. Machine: {platform.machine()}, "
-        f"{os.cpu_count()} cores ({platform.processor() or 'CPU not reported'}), Python {platform.python_version()}; "
+        f"{os.cpu_count()} cores ({processor()}), Python {platform.python_version()}; "
         f"{args.workers} run(s) at a time, one core each.", "",
         f"Machine unit: one LAPACK dgbtrf + dgbtrs of {UNIT_SIZE} unknowns, kl = ku = {UNIT_BANDWIDTH}: "
         f"{unit_before * 1e3:.1f} ms before the runs, {unit_after * 1e3:.1f} ms after; the mean is the unit.", "",
