@@ -2,7 +2,7 @@
 PY := .venv/bin/python
 OUT ?= out
 
-.PHONY: setup docs demo demo-printed demo-as-printed reproduction test bench bench-ross campbell wells drilling mc optimize stick-slip clean
+.PHONY: setup docs demo demo-printed demo-as-printed reproduction test bench bench-ross campbell wells drilling drill-vbh mc optimize stick-slip clean
 
 setup:
 	@bash scripts/bootstrap.sh
@@ -54,6 +54,7 @@ docs: setup
 ## the reduced models against the full order (benchmarks/results/reduced_accuracy.md), then the fidelity studies
 ## (benchmarks/README.md lists every script).
 bench: setup
+	$(PY) benchmarks/speed.py --workers 1
 	$(PY) benchmarks/speed_table.py --before 50d35ac
 	$(PY) benchmarks/evaluation_costs.py
 	$(PY) benchmarks/reduced_accuracy.py --t-end 2 --runs $(OUT)/accuracy
@@ -100,6 +101,16 @@ drilling: setup
 	cp $(OUT)/bh-run/fig15_bit_rotation.png docs/figures/drilling_bit_rotation.png
 	cp $(OUT)/bh-run/torque_drag.png docs/figures/drilling_torque_drag.png
 	cp $(OUT)/bh-run/fig16b_orbit.png docs/figures/drilling_orbit.png
+
+## Drilling the 3 km VBH demo well on bottom for VBH_SECONDS (default 60) on 2000 elements, the full order: its
+## bit speed, the whirl orbit at the BHA, the hook load and the surface torque (docs/wells.md gives its cost).
+VBH_SECONDS ?= 60
+drill-vbh: setup
+	$(PY) -m fenics_drill.cli run demos/scenes/well_vbh.toml --set beam.elements=2000 --set time.t_end=$(VBH_SECONDS) --out $(OUT)/vbh-drilling --overwrite
+	$(PY) -m fenics_drill.cli plot $(OUT)/vbh-drilling --no-gif
+	cp $(OUT)/vbh-drilling/fig15_bit_rotation.png docs/figures/vbh_drilling_bit_rotation.png
+	cp $(OUT)/vbh-drilling/fig16b_orbit.png docs/figures/vbh_drilling_orbit.png
+	cp $(OUT)/vbh-drilling/torque_drag.png docs/figures/vbh_drilling_torque_drag.png
 
 ## The paper's Monte Carlo study (Section 6.11) at SAMPLES realisations on RANKS processes (with the default Coulomb
 ## friction each realisation of 10 s runs the full order, about 160 s on one core here).
