@@ -111,6 +111,7 @@ drill-vbh: setup
 	cp $(OUT)/vbh-drilling/fig15_bit_rotation.png docs/figures/vbh_drilling_bit_rotation.png
 	cp $(OUT)/vbh-drilling/fig16b_orbit.png docs/figures/vbh_drilling_orbit.png
 	cp $(OUT)/vbh-drilling/torque_drag.png docs/figures/vbh_drilling_torque_drag.png
+	cp $(OUT)/vbh-drilling/surface_loads.png docs/figures/vbh_drilling_surface_loads.png
 
 ## The paper's Monte Carlo study (Section 6.11) at SAMPLES realisations on RANKS processes (with the default Coulomb
 ## friction each realisation of 10 s runs the full order, about 160 s on one core here).

@@ -3,7 +3,7 @@
 timeseries.h5 -> Fig. 14 bit displacement and velocity, Fig. 15 bit rotation and
 angular velocity, Fig. 16 transverse displacement and velocity at the section,
 Fig. 17 radial displacement at the section against the gap, Fig. 18 impacts against
-time, Fig. 19 impacts per vertex, Figs. 21-23 power spectral densities and
+time, Fig. 19 impacts per vertex, the hook load and surface torque (surface_loads.png), Figs. 21-23 power spectral densities and
 spectra.json (Section 6.8 peaks with the nearest natural frequencies); fields.h5 ->
 Figs. 13 and 20 and animation.gif (:mod:`fenics_drill.plots.pictures`).  Units are
 converted here, at the plotting edge only (mm, m/h, rev, rpm as in the paper).
@@ -64,6 +64,9 @@ def time_series_figures(data: dict, attrs: dict, out: Path) -> list[Path]:
     if not np.any(per_vertex):
         ax.text(0.5, 0.5, "no impact in this run", transform=ax.transAxes, ha="center", va="center", color="0.4")
     paths += [path18, save_figure(fig, out / "fig19_impacts_position.png")]
+    if "lambda_1" in data and "lambda_4" in data:  # the drive's multipliers: lambda_1 the hook load, -lambda_4 the torque
+        paths.append(_time_pair(out / "surface_loads.png", t, data["lambda_1"] / 1e3, -data["lambda_4"] / 1e3,
+                                ("hook load [kN]", "surface torque [kN m]"), "The drive's loads at the surface"))
     return paths
 
 

@@ -60,7 +60,7 @@ def test_run_writes_summary_timeseries_and_fields(tmp_path):
     # fenics-drill plot: every figure, the spectra and the animation from the saved files alone
     assert main(["plot", str(tmp_path)]) == 0
     for name in ("fig13_static_3d", "fig14_bit_axial", "fig17_section_radial", "fig19_impacts_position",
-                 "fig20_sections", "fig20_3d", "fig21_psd", "fig22_psd", "fig23_psd"):
+                 "surface_loads", "fig20_sections", "fig20_3d", "fig21_psd", "fig22_psd", "fig23_psd"):
         assert (tmp_path / f"{name}.png").stat().st_size > 10_000, name
     assert (tmp_path / "animation.gif").exists()
     spectra = json.loads((tmp_path / "spectra.json").read_text())
