@@ -102,7 +102,7 @@ drilling: setup
 	cp $(OUT)/bh-run/torque_drag.png docs/figures/drilling_torque_drag.png
 	cp $(OUT)/bh-run/fig16b_orbit.png docs/figures/drilling_orbit.png
 
-## Drilling the 3 km VBH demo well on bottom for VBH_SECONDS (default 60) on 2000 elements, the full order: its
+## Drilling the 3 km VBH demo well for VBH_SECONDS (default 60) on 2000 elements, the full order: its
 ## bit speed, the whirl orbit at the BHA, the hook load and the surface torque (docs/wells.md gives its cost).
 VBH_SECONDS ?= 60
 drill-vbh: setup
