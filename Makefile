@@ -114,7 +114,7 @@ drill-vbh: setup
 	cp $(OUT)/vbh-drilling/surface_loads.png docs/figures/vbh_drilling_surface_loads.png
 
 ## The paper's Monte Carlo study (Section 6.11) at SAMPLES realisations on RANKS processes (with the default Coulomb
-## friction each realisation of 10 s runs the full order, about 160 s on one core here).
+## friction each realisation of 10 s runs the full order: 8 took 327 s on 2 ranks here, docs/performance.md).
 SAMPLES ?= 32
 RANKS ?= 2
 mc: setup
