@@ -76,6 +76,7 @@ def test_torque_drag_and_the_run_answer_the_same_question(well):
     """One place holds the set points: the soft string drills with the drive's weight on bit, rotation speed and rate
     of penetration unless [torque_drag] gives its own."""
     _, scene, _ = well
+    # the drive's own numbers passed on: equal but for the round-off of their unit conversions
     assert scene.set_points == {"weight_on_bit": 40e3, "rotation_speed": pytest.approx(2 * np.pi, rel=1e-15),
                                 "rate_of_penetration": pytest.approx(1 / 180, rel=1e-15)}
     own = scene.with_changes(torque_drag={"weight_on_bit": 30e3})
