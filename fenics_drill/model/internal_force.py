@@ -19,7 +19,6 @@ import functools
 import weakref
 from dataclasses import dataclass
 
-import dolfinx.fem.petsc as fem_petsc
 import numpy as np
 import scipy.sparse as sp
 import ufl
@@ -27,7 +26,7 @@ from dolfinx import fem
 from petsc4py import PETSc
 
 from fenics_drill.forms import energies
-from fenics_drill.model.kernels.banded_saddle import SparseSum
+from fenics_drill.model.kernels.banded_saddle import KeptEntries, SparseSum
 from fenics_drill.model.kernels.cell_kernels import CellAssembly
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.operators import LinearOperators
@@ -158,8 +157,9 @@ class AssembledInternalForce:
     stay the gradients of an energy and the budget still closes (Farhat et al. 2014).
 
     A modal space's force and energies come from the cells' kernels (:class:`SampledCoefficients`: all
-    cells, or the sample's), a third faster than DOLFINx's assembly and projection over all cells; its
-    tangents over all cells, and everything of the full order, through DOLFINx.
+    cells, or the sample's), a third faster than DOLFINx's assembly and projection over all cells.  Its tangents
+    over all cells, and everything of the full order, come from the same kernels over every cell, with the
+    coefficients packed by DOLFINx (:class:`TangentEntries`, :meth:`assembled_vector`).
     """
 
     def __init__(self, disc: BeamDiscretization, space, operators: LinearOperators,
@@ -176,12 +176,12 @@ class AssembledInternalForce:
                                                                        forms.jacobians)
         # the dofs of the sampled cells: the only ones their kernels read
         self.dofs = None if sample is None else np.unique(disc.V.dofmap.list[sample.cells]).astype(PETSc.IntType)
-        # the cells whose kernels a modal space's force runs on, and their dofs (None: DOLFINx's assembly)
+        # the cells whose kernels a modal space's force runs on from q, and their dofs (None: the functions set, their
+        # coefficients packed by DOLFINx: :meth:`assembled_vector`)
         self._kernel_cells = None if space.sparse else (
             (sample.cells, self.dofs) if sample is not None else
             (np.arange(disc.elements, dtype=np.int32), np.arange(disc.ndofs)))
-        self._vector = fem_petsc.create_vector(self._residual.function_spaces)
-        if sample is None:  # DOLFINx's own CSR matrices, read at the entries that matter
+        if sample is None:  # the kernels' element matrices, read at the entries that matter
             self._matrices = tuple(TangentEntries(form, space, forms.functions) if form is not None
                                    else None for form in self._jacobians)
         else:  # the nonlinear remainder on the sampled cells, from (q, qd, qdd) through their kernels
@@ -209,6 +209,12 @@ class AssembledInternalForce:
         return self._sampled(self._residual, (self.U, self.V, self.A))
 
     @functools.cached_property
+    def _residual_cells(self) -> CellAssembly:
+        """The residual form's kernels over all its cells, into a vector at every dof (:meth:`assembled_vector`)."""
+        index_map = self._residual.function_spaces[0].dofmap.index_map
+        return CellAssembly(self._residual, np.arange(index_map.size_local + index_map.num_ghosts))
+
+    @functools.cached_property
     def _tangent_cells(self) -> tuple:
         return tuple(self._sampled(form, (self.U, self.V, self.A)) if form is not None else None
                      for form in self._jacobians)
@@ -233,10 +239,8 @@ class AssembledInternalForce:
         self._set(self.U, q)
         self._set(self.V, qd)
         self._set(self.A, qdd)
-        with self._vector.localForm() as local:
-            local.set(0.0)
-        fem_petsc.assemble_vector(self._vector, self._residual)
-        return self._vector.array
+        (packed,) = fem.pack_coefficients(self._residual).values()
+        return self._residual_cells(packed)
 
     def element_vectors(self, q, qd, qdd) -> np.ndarray:
         """Each sampled cell's element vector of the residual form, weighted, in the order of its dofs
@@ -435,44 +439,52 @@ class SampledCoefficients:
 
 
 class TangentEntries:
-    """A tangent form assembled into DOLFINx's CSR matrix and read as COO at the entries that are not zero
-    for every state and, in the full space, couple two free dofs (renumbered as the space's unknowns).
+    """A tangent form assembled by its FFCx kernel cell by cell (:class:`~fenics_drill.model.kernels.cell_kernels.
+    CellAssembly`: no DOLFINx matrix) and read as COO at the element entries that are not zero for every state and,
+    in the full space, couple two free dofs (renumbered as the space's unknowns); a pair of dofs that two cells share
+    is one entry of each (COO adds them up).
 
-    The form's pattern couples every field of an element with every other, most of them with zeros
-    (189 k entries, 50 k nonzero on 1000 elements): the entries to keep are those nonzero at two random
-    states, found once, so an assembly is DOLFINx's kernel loop and one gather."""
+    The form's element matrix couples every field of an element with every other, most of them with zeros (225
+    entries per element, about a third nonzero): the entries to keep are those nonzero at two random states, found
+    once, so an assembly is the kernels' loop and one gather.  Against DOLFINx's assembly into its CSR matrix and
+    a gather of that: 2.5 times less time for df/dq, 7 times less for df/dqd and df/dqdd (3 km, docs/performance.md)."""
 
     #: Random states that find the entries to keep: displacements and rates of this size (rotations in
     #: rad), so that no term of the energies' polynomials and sines vanishes by accident.
     PROBE_SIZE, PROBES = 0.3, 2
 
     def __init__(self, form: fem.Form, space, functions):
-        self.form, self.matrix, self.space = form, fem.create_matrix(form), space
-        n_dofs = self.matrix.indptr.size - 1
-        rows = np.repeat(np.arange(n_dofs), np.diff(self.matrix.indptr))
+        self.form, self.space = form, space
+        index_map = form.function_spaces[0].dofmap.index_map
+        n_dofs = index_map.size_local + index_map.num_ghosts
+        self.cells = CellAssembly(form, np.arange(n_dofs))
+        cell_dofs, n = self.cells.cell_dofs, self.cells.cell_dofs.shape[1]
+        rows = np.repeat(cell_dofs, n, axis=1).ravel()  # entry k n + m of a cell's matrix: (its dof k, its dof m)
+        columns = np.tile(cell_dofs, (1, n)).ravel()
         # the full space keeps the free dofs, renumbered; a modal space projects every dof's entries
         position = space.position if space.sparse else np.arange(n_dofs)
         self.shape = (space.size,) * 2 if space.sparse else (n_dofs,) * 2
-        kept = (position[rows] >= 0) & (position[self.matrix.indices] >= 0)
+        kept = (position[rows] >= 0) & (position[columns] >= 0)
         saved = [function.x.array.copy() for function in functions]
-        rng, nonzero = np.random.default_rng(0), np.zeros(self.matrix.data.size, dtype=bool)
+        rng, nonzero = np.random.default_rng(0), np.zeros(rows.size, dtype=bool)
         for _ in range(self.PROBES):
             for function in functions:
                 function.x.array[:] = self.PROBE_SIZE * rng.standard_normal(function.x.array.size)
-            nonzero |= self._assembled() != 0.0
+            (packed,) = fem.pack_coefficients(self.form).values()
+            nonzero |= self.cells.element_tensors(packed).ravel() != 0.0
         for function, values in zip(functions, saved):
             function.x.array[:] = values
-        self.keep = np.flatnonzero(kept & nonzero)
-        self.rows, self.columns = position[rows[self.keep]], position[self.matrix.indices[self.keep]]
-
-    def _assembled(self) -> np.ndarray:
-        self.matrix.data[:] = 0.0
-        fem.assemble_matrix(self.matrix, self.form)
-        return self.matrix.data
+        keep = np.flatnonzero(kept & nonzero)
+        self.layout = self.cells.kept_layout(keep)
+        # scipy's index type below 2^31 unknowns: a COO matrix built on them takes them as they are, without a cast
+        index = np.int32 if max(self.shape) < 2**31 else np.int64
+        self.rows, self.columns = position[rows[keep]].astype(index), position[columns[keep]].astype(index)
 
     def assemble(self):
         """The projected form at the functions' current values (COO in the full space, dense in a modal one)."""
-        entries = sp.coo_matrix((self._assembled()[self.keep], (self.rows, self.columns)), shape=self.shape)
+        (packed,) = fem.pack_coefficients(self.form).values()
+        entries = KeptEntries((self.cells.kept_entries(packed, self.layout), (self.rows, self.columns)),
+                              shape=self.shape)
         return entries if self.space.sparse else self.space.project_matrix(entries)
 
 

@@ -9,6 +9,7 @@ from dolfinx import fem
 
 from fenics_drill.model.kernels.cell_kernels import CellAssembly
 from fenics_drill.model.discretization import BeamDiscretization
+from fenics_drill.model.drillstring import build_model
 from fenics_drill.model.forces.wall.vertex_passes import _contact_blocks, _modal_pass, _projected_laws, _vertex_loads
 from fenics_drill.model.internal_force import ElementSample, InternalForms, SampledCoefficients
 from fenics_drill.solvers.static import solve_static
@@ -121,6 +122,30 @@ def test_the_sampled_forms_projected_cell_by_cell_are_the_projections_of_their_a
         # projected cell by cell instead of after assembly: sums of up to 15 x 15 x 4 products per entry in
         # another order (Higham: n eps ~ 2e-13 of the sum of magnitudes), so 1e-12 of the largest entry
         np.testing.assert_allclose(ours, reference, rtol=0, atol=1e-12 * np.abs(reference).max())
+
+
+def test_the_full_orders_force_and_tangent_parts_are_dolfinx_assembly_of_its_forms():
+    """The full order's internal force and its tangent parts df/dq, df/dqd, df/dqdd, assembled by the forms' FFCx
+    kernels in one compiled loop over the cells (coefficients packed by DOLFINx, the tangents read at the entries
+    that matter, fenics_drill/model/internal_force.py), against DOLFINx's assemble_vector and assemble_matrix of the
+    same forms at the free dofs, at three random states (displacements, rates and rotations of 0.3 in SI units:
+    every polynomial and sine of the energies active).  The same element tensors summed in another order: an entry
+    sums at most two cells' values, so a few ulps of the largest entry (1e-13 is about 500 eps)."""
+    import dolfinx.fem.petsc as fem_petsc
+
+    model = build_model(scene_with(*STRING, "reduction.rule=none"))
+    force, space = model.internal, model.space
+    rng = np.random.default_rng(12)
+    for _ in range(3):
+        state = [0.3 * rng.standard_normal(model.size) for _ in range(3)]
+        ours = force.evaluate(*state)
+        reference = space.project(fem_petsc.assemble_vector(force._residual).array)
+        assert np.abs(reference).max() > 0
+        np.testing.assert_allclose(ours, reference, rtol=0, atol=1e-13 * np.abs(reference).max())
+        for part, jacobian in zip(force.tangent_parts(), force._jacobians):
+            reference = space.project_matrix(fem.assemble_matrix(jacobian).to_scipy()).toarray()
+            assert np.abs(reference).max() > 0
+            np.testing.assert_allclose(part.toarray(), reference, rtol=0, atol=1e-13 * np.abs(reference).max())
 
 
 def test_cell_assembly_refuses_a_bilinear_form_of_two_spaces(sampled_forms):

@@ -181,6 +181,23 @@ def _tabulate_cells(address, coefficients, constants, coordinates, size):
     return out
 
 
+@kernel
+def _kept_cell_entries(address, coefficients, constants, coordinates, size, start, local):
+    """Entries ``local[start[c]:start[c + 1]]`` of each cell c's element tensor (of ``size`` values), one cell after
+    the other: the entries of a matrix that matter, without the whole tensors."""
+    out = np.empty(local.size)
+    element = np.empty(size)
+    entity, permutation = np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
+    for c in range(coordinates.shape[0]):
+        element[:] = 0.0
+        _call_at(address, _FFI.from_buffer(element), _FFI.from_buffer(coefficients[c]), _FFI.from_buffer(constants),
+                 _FFI.from_buffer(coordinates[c]), _FFI.from_buffer(entity), _FFI.from_buffer(permutation),
+                 _FFI.from_buffer(permutation))
+        for i in range(start[c], start[c + 1]):
+            out[i] = element[local[i]]
+    return out
+
+
 @njit(cache=True)
 def tabulate_at_cells(address, dofs, cell_dofs, constants, coordinates, out):
     """An expression of one function (block size 1) at every cell, into the rows of ``out`` (cells x its
@@ -308,10 +325,26 @@ class CellAssembly:
     def element_tensors(self, coefficients: np.ndarray) -> np.ndarray:
         """Each cell's element tensor (cells x its size: 1, the cell's dofs, or their square, row-major) from
         the cells' packed coefficients."""
-        n = self.cell_dofs.shape[1]
-        size = n * n if self.rank == 2 else (n if self.rank == 1 else 1)
         packed = np.ascontiguousarray(coefficients, dtype=float).reshape(len(self.coordinates), -1)
-        return _tabulate_cells(self.address, packed, self.constants, self.coordinates, size)
+        return _tabulate_cells(self.address, packed, self.constants, self.coordinates, self._tensor_size())
+
+    def _tensor_size(self) -> int:
+        """The values of one cell's element tensor: 1, the cell's dofs, or their square."""
+        n = self.cell_dofs.shape[1]
+        return n * n if self.rank == 2 else (n if self.rank == 1 else 1)
+
+    def kept_layout(self, kept: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Where :meth:`kept_entries` reads the entries ``kept`` (increasing indices into the cells' element tensors
+        flattened one after the other, as :meth:`element_tensors` gives them): each cell's first one, and each one's
+        index in its cell's tensor."""
+        cell, local = np.divmod(kept, self._tensor_size())
+        return np.searchsorted(cell, np.arange(len(self.coordinates) + 1)), local
+
+    def kept_entries(self, coefficients: np.ndarray, layout: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+        """The entries of :meth:`kept_layout` from the cells' packed coefficients."""
+        packed = np.ascontiguousarray(coefficients, dtype=float).reshape(len(self.coordinates), -1)
+        return _kept_cell_entries(self.address, packed, self.constants, self.coordinates, self._tensor_size(),
+                                  *layout)
 
     def projected(self, offset, rows, row_function, row_dof, state, basis, basis_by_field):
         """The number, or the vector or matrix projected on ``basis`` (the rows of [Phi] at the dofs:
