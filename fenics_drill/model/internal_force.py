@@ -26,7 +26,7 @@ from dolfinx import fem
 from petsc4py import PETSc
 
 from fenics_drill.forms import energies
-from fenics_drill.model.kernels.banded_saddle import KeptEntries, SparseSum
+from fenics_drill.model.kernels.banded_saddle import SparseSum
 from fenics_drill.model.kernels.cell_kernels import CellAssembly
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.operators import LinearOperators
@@ -483,8 +483,8 @@ class TangentEntries:
     def assemble(self):
         """The projected form at the functions' current values (COO in the full space, dense in a modal one)."""
         (packed,) = fem.pack_coefficients(self.form).values()
-        entries = KeptEntries((self.cells.kept_entries(packed, self.layout), (self.rows, self.columns)),
-                              shape=self.shape)
+        entries = sp.coo_matrix((self.cells.kept_entries(packed, self.layout), (self.rows, self.columns)),
+                                shape=self.shape)
         return entries if self.space.sparse else self.space.project_matrix(entries)
 
 

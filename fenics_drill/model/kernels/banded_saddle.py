@@ -70,32 +70,6 @@ def _band_fill(rows, columns, data, position, taken_slot, kl, ku, band, taken_co
     return outside
 
 
-@kernel
-def _add_scaled(out, c, x):
-    """out += c x, in place, for 2-d arrays of one shape (column by column: a band is stored in Fortran order)."""
-    for j in range(out.shape[1]):
-        for i in range(out.shape[0]):
-            out[i, j] += c * x[i, j]
-
-
-class KeptEntries(sp.coo_matrix):
-    """A COO matrix that many tangents hold (a part of the internal tangent, kept over Newton iterations and steps
-    while the step size, and so its coefficient, changes): laid out in each band layout once, then added to a band
-    as a scaled band (:func:`_add_scaled`: about a third of the time of laying its entries out again at 3 km)."""
-
-    def laid_out(self, layout: "BandLayout", own: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(band, taken-out columns, taken-out rows) of this matrix alone in ``layout`` (``own``: :class:`SparseSum`)."""
-        bands = self.__dict__.setdefault("_bands", {})
-        key = (layout.key, own)
-        if key not in bands:
-            arrays = layout.empty()
-            layout.fill(self, 1.0, own, *arrays)
-            if len(bands) > 2:  # laid out for one or two saddle systems (a run's and its statics')
-                bands.clear()
-            bands[key] = arrays
-        return bands[key]
-
-
 class SparseSum:
     """sum of c A over the (c, A) of ``terms`` (sparse matrices, or sums themselves), kept as its terms: the banded
     solve lays each term into the band itself, and a term kept across many tangents (the internal tangent, kept
@@ -155,9 +129,6 @@ def _add_terms(terms, layout: "BandLayout", arrays, own: bool) -> None:
                 mine += theirs if c == 1.0 else c * theirs
         elif isinstance(matrix, SparseSum):
             _add_terms([(c * inner, leaf) for inner, leaf in matrix.terms], layout, arrays, own or matrix.own)
-        elif isinstance(matrix, KeptEntries):
-            for mine, theirs in zip(arrays, matrix.laid_out(layout, own)):
-                _add_scaled(mine, c, theirs)
         else:
             layout.fill(matrix, c, own, *arrays)
 
