@@ -93,13 +93,17 @@ def uninterrupted(stop_after: bool = True, comm=None):
     stop.deferring += 1
     try:
         yield
+        agreed = stop.requested
+        if stop_after and comm is not None:
+            from mpi4py import MPI
+
+            # told while the signal is still deferred: a rank waiting here for a slower one, where a signal most
+            # often lands, must not leave the exchange alone (the other would stop a step later, in a collective
+            # this rank never joins); a signal after its share was sent waits for the next step's exchange
+            agreed = comm.allreduce(stop.requested, op=MPI.LOR)
     finally:
         stop.deferring -= 1
-    if stop_after and comm is not None:
-        from mpi4py import MPI
-
-        stop.requested = comm.allreduce(stop.requested, op=MPI.LOR)
-    if stop_after and stop.requested and not stop.deferring:
+    if stop_after and (agreed or (comm is None and stop.requested)) and not stop.deferring:
         raise KeyboardInterrupt
 
 
