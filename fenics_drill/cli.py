@@ -396,8 +396,11 @@ def _execute(args) -> int:
         else:
             import traceback
 
+            # the line that names the rank first: MPI_Abort can end the job before the launcher has passed on the
+            # last of a rank's output, and then only the traceback's tail is lost
+            _say(f"fenics-drill{where}: failed ({type(err).__name__}); ending every rank")
             traceback.print_exc()
-            _say(f"fenics-drill{where}: failed; ending every rank")
+            sys.stderr.flush()
         if comm.size > 1:
             comm.Abort(1)
         return 1
