@@ -141,10 +141,14 @@ def test_the_full_orders_force_and_tangent_parts_are_dolfinx_assembly_of_its_for
         ours = force.evaluate(*state)
         reference = space.project(fem_petsc.assemble_vector(force._residual).array)
         assert np.abs(reference).max() > 0
+        # the same element vectors added in another order: an entry sums at most two cells' values, a few ulps of
+        # the largest entry; 1e-13 is about 500 eps
         np.testing.assert_allclose(ours, reference, rtol=0, atol=1e-13 * np.abs(reference).max())
         for part, jacobian in zip(force.tangent_parts(), force._jacobians):
             reference = space.project_matrix(fem.assemble_matrix(jacobian).to_scipy()).toarray()
             assert np.abs(reference).max() > 0
+            # the same element matrices: the COO's repeated entries (a dof pair of two cells) summed by SciPy, DOLFINx's
+            # in its CSR, in another order; a few ulps of the largest entry, 1e-13 is about 500 eps
             np.testing.assert_allclose(part.toarray(), reference, rtol=0, atol=1e-13 * np.abs(reference).max())
 
 

@@ -39,6 +39,15 @@ def _call_at(typingctx, address, element, coefficients, constants, coordinates, 
     return signature, codegen
 
 
+@njit(cache=True, inline="always")
+def _cell_tensor(address, out, coefficients, constants, coordinates, entity, permutation):
+    """One cell's element tensor into ``out`` by the kernel at ``address`` (ufcx ``tabulate_tensor``), from the cell's
+    packed coefficients and coordinates (an interval's cells need no entity index or permutation: zeros)."""
+    _call_at(address, _FFI.from_buffer(out), _FFI.from_buffer(coefficients), _FFI.from_buffer(constants),
+             _FFI.from_buffer(coordinates), _FFI.from_buffer(entity), _FFI.from_buffer(permutation),
+             _FFI.from_buffer(permutation))
+
+
 @njit(cache=True, fastmath=set(REASSOCIATE))
 def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, square, basis, basis_by_field, out):
     """Add every cell's element tensor to ``out``: at the positions ``cell_dofs`` (a vector of ``size``, or
@@ -57,9 +66,7 @@ def _add_cells(address, coefficients, constants, coordinates, cell_dofs, size, s
     entity, permutation = np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
     for c in range(cell_dofs.shape[0]):
         element[:] = 0.0
-        _call_at(address, _FFI.from_buffer(element), _FFI.from_buffer(coefficients[c]), _FFI.from_buffer(constants),
-                 _FFI.from_buffer(coordinates[c]), _FFI.from_buffer(entity), _FFI.from_buffer(permutation),
-                 _FFI.from_buffer(permutation))
+        _cell_tensor(address, element, coefficients[c], constants, coordinates[c], entity, permutation)
         if modes == 0 and square:
             for k in range(n):
                 for m in range(n):
@@ -175,9 +182,7 @@ def _tabulate_cells(address, coefficients, constants, coordinates, size):
     out = np.zeros((coordinates.shape[0], size))
     entity, permutation = np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
     for c in range(coordinates.shape[0]):
-        _call_at(address, _FFI.from_buffer(out[c]), _FFI.from_buffer(coefficients[c]), _FFI.from_buffer(constants),
-                 _FFI.from_buffer(coordinates[c]), _FFI.from_buffer(entity), _FFI.from_buffer(permutation),
-                 _FFI.from_buffer(permutation))
+        _cell_tensor(address, out[c], coefficients[c], constants, coordinates[c], entity, permutation)
     return out
 
 
@@ -190,9 +195,7 @@ def _kept_cell_entries(address, coefficients, constants, coordinates, size, star
     entity, permutation = np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
     for c in range(coordinates.shape[0]):
         element[:] = 0.0
-        _call_at(address, _FFI.from_buffer(element), _FFI.from_buffer(coefficients[c]), _FFI.from_buffer(constants),
-                 _FFI.from_buffer(coordinates[c]), _FFI.from_buffer(entity), _FFI.from_buffer(permutation),
-                 _FFI.from_buffer(permutation))
+        _cell_tensor(address, element, coefficients[c], constants, coordinates[c], entity, permutation)
         for i in range(start[c], start[c + 1]):
             out[i] = element[local[i]]
     return out
@@ -209,9 +212,7 @@ def tabulate_at_cells(address, dofs, cell_dofs, constants, coordinates, out):
         for k in range(cell_dofs.shape[1]):
             local[k] = dofs[cell_dofs[c, k]]
         out[c, :] = 0.0
-        _call_at(address, _FFI.from_buffer(out[c]), _FFI.from_buffer(local), _FFI.from_buffer(constants),
-                 _FFI.from_buffer(coordinates[c]), _FFI.from_buffer(entity), _FFI.from_buffer(permutation),
-                 _FFI.from_buffer(permutation))
+        _cell_tensor(address, out[c], local, constants, coordinates[c], entity, permutation)
 
 
 @kernel
