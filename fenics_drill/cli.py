@@ -43,12 +43,11 @@ def _scene_args(parser: argparse.ArgumentParser, out: bool = True) -> None:
 def cmd_scene(args) -> int:
     """Print the validated scene with every default filled in, as TOML; a well's survey and sections are read and
     related to the string as every command does (a missing or unsorted survey file is refused here too)."""
-    scene = load_scene(args.scene, args.overrides)
-    if scene.well.survey or scene.well.md or scene.string.sections:
-        from fenics_drill.model.string_sections import string_sections
-        from fenics_drill.model.well import well_of
+    from fenics_drill.model.well import well_notes
 
-        well_of(scene, string_sections(scene)[-1].bottom)
+    scene = load_scene(args.scene, args.overrides)
+    for note in well_notes(scene):  # the checks of the string in its well, every command's first
+        print(f"# note: {note}")
     written = getattr(scene, "written", {})
     unused = unused_keys(scene)
     for section, entries in scene.to_dict().items():
@@ -85,6 +84,8 @@ def cmd_modal(args) -> int:
     if report["first_torsional_period_s"]:
         print(f"drive-held, bit off bottom: first torsional mode {report['first_torsional_frequency_hz']:.4g} Hz "
               f"(period {report['first_torsional_period_s']:.4g} s)")
+    if report.get("buckled"):
+        print(f"BUCKLED: {report['buckled']['message']}")
     if report["lateral_critical_speeds_rpm"]:
         print("lateral critical speeds (order 1, not spinning; `fenics-drill campbell` for the spinning string): "
               + ", ".join(f"{r:.4g}" for r in report["lateral_critical_speeds_rpm"]) + " rpm")
@@ -107,8 +108,14 @@ def cmd_static(args) -> int:
     else:
         shape = f"max sag {report['max_sag'] * 1e3:.3f} mm at x = {report['max_sag_position']:.1f} m"
     pressed = f", the bit pressed at {report['weight_on_bit'] / 1e3:.4g} kN" if report.get("weight_on_bit") else ""
-    print(f"{shape}, {len(report['contact_vertices'])} vertices on the wall, hook load {report['hook_load'] / 1e3:.2f} "
-          f"kN{pressed} -> {Path(args.out) / 'static.json'}")
+    hook = report["hook_load"]
+    top = f"hook load {hook / 1e3:.2f} kN" if hook >= 0 else f"the top pushes with {-hook / 1e3:.2f} kN (a hook load of " \
+        f"{hook / 1e3:.2f} kN: the weight on bit asks more than the string weighs along its axis)"
+    print(f"{shape}, {len(report['contact_vertices'])} vertices on the wall, {top}{pressed} -> "
+          f"{Path(args.out) / 'static.json'}")
+    buckling = report.get("buckling") or {}
+    if buckling.get("message") and not buckling.get("unstable"):
+        print(f"buckled: {buckling['message']}")
     for reason in report.get("suspect_reasons", []):
         print(f"suspect: {reason}")
     return 0
@@ -355,6 +362,23 @@ def _collective_errors() -> tuple[type, ...]:
     return SceneError, OutputError, InadmissibleLaw, RankCountError
 
 
+def _say_notes(args) -> None:
+    """The notes a command's summary.json holds of its scene (where the bit is, what the survey's reader left out),
+    one line each on stdout, after its results."""
+    from fenics_drill.io.files import UnreadableFile, read_json
+
+    out = getattr(args, "out", None)
+    summary = Path(out) / "summary.json" if out else None
+    if summary is None or not summary.is_file() or args.command == "plot":
+        return
+    try:
+        notes = read_json(summary).get("notes", [])
+    except UnreadableFile:
+        return
+    for note in notes if isinstance(notes, list) else []:
+        print(f"note: {note}")
+
+
 def _execute(args) -> int:
     """Run a command in this process; ordinary errors become messages, other errors under MPI end the job."""
     from mpi4py import MPI
@@ -366,7 +390,9 @@ def _execute(args) -> int:
     comm = MPI.COMM_WORLD
     where = f" (rank {comm.rank} of {comm.size})" if comm.size > 1 else ""
     try:
-        return args.func(args)
+        code = args.func(args)
+        _say_notes(args)
+        return code
     except _user_errors() as err:
         kind = "scene error: " if isinstance(err, SceneError) else ""
         _say(f"fenics-drill{where}: {kind}{err}")

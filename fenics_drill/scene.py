@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any, Callable, get_type_hints
 
 from fenics_drill.forms import BeamProperties
+from fenics_drill.units import DEPTH_ROUND_OFF
 
 
 #: The longest string a scene may describe [m] (the longest wells drilled are about 15 km).
@@ -152,7 +153,7 @@ class Drive:
     mode: str = key("velocity", "axial drive: 'velocity' (u(0) = V0 t) or 'hook_load' (push with drive.weight_on_bit)",
                     choices=("velocity", "hook_load"))
     weight_on_bit: float = _pos("set weight on bit: a hook-load drive's, and an on-bottom start's [N]", 25e3)
-    start: str = key("auto", "initial state: 'off_bottom', 'on_bottom' (at weight_on_bit) or 'auto' (hook load in a well)",
+    start: str = key("auto", "initial state: 'off_bottom', 'on_bottom' (at weight_on_bit) or 'auto' (on bottom in a well)",
                      choices=("auto", "off_bottom", "on_bottom"))
     controller: str = key("stiff", "rotary drive: 'stiff' (theta_x(0) = Omega t), 'pi' or 'soft_torque' (top drive)",
                           choices=("stiff", "pi", "soft_torque"))
@@ -327,7 +328,8 @@ class Well:
     """The well from its survey (minimum curvature) and its hole sections; absent, the straight horizontal hole
     of ``beam.length`` and ``borehole.radius``."""
 
-    survey: str = key("", "survey CSV file (columns md, inclination, azimuth), relative to the scene file")
+    survey: str = key("", "survey CSV file (columns md, inclination, azimuth), relative to the scene file (given with "
+                      "--set: to the working directory)")
     md: tuple = key((), "measured depths of the survey stations, inline instead of a file [m]", _numbers,
                     "a list of numbers")
     inclination: tuple = key((), "inclination of each station from the vertical [deg]", _numbers, "a list of numbers")
@@ -536,10 +538,10 @@ class Scene:
     @property
     def starts_on_bottom(self) -> bool:
         """Whether a run starts from the static state with ``drive.weight_on_bit`` on the bit: ``drive.start``, where
-        'auto' is on bottom for a hook-load drive in a well (the paper's horizontal string starts off bottom)."""
+        'auto' is on bottom in a well, whatever drives the top (the paper's horizontal string starts off bottom)."""
         if self.drive.start != "auto":
             return self.drive.start == "on_bottom"
-        return self.drive.mode == "hook_load" and bool(self.well.survey or self.well.md)
+        return bool(self.well.survey or self.well.md)
 
     def law(self, choice: str) -> str:
         """'consistent' or 'printed' for a per-law switch (``contact.axial_friction_law``, ...)."""
@@ -615,15 +617,14 @@ def _describe_kind(kind) -> str:
 def with_unit(name: str, value: str, meaning: str) -> float:
     """A value written with its unit ("120 rpm") in the SI unit of the key's ``meaning`` (:mod:`fenics_drill.units`),
     or a SceneError naming the key."""
-    from fenics_drill.units import UnitError, si_unit, to_si
+    from fenics_drill.units import UnitError, read_number, read_quantity, si_unit
 
     unit = si_unit(meaning)
-    if unit is None:
-        raise SceneError(f"{name} = {value!r} is not admissible: expected a number (this key takes no unit)")
     try:
-        return to_si(value, unit)
+        return read_number(value) if unit is None else read_quantity(value, unit)
     except UnitError as err:
-        raise SceneError(f"{name} = {value!r} is not admissible: {err}") from None
+        reason = "expected a number (this key takes no unit)" if unit is None else err
+        raise SceneError(f"{name} = {value!r} is not admissible: {reason}") from None
 
 
 def _coerce(name: str, value: Any, kind: type, meta) -> Any:
@@ -703,12 +704,13 @@ def _check_relations(scene: Scene) -> Scene:
         hole_at_bit, which = hole.radius, "borehole.radius"
         if scene.well.hole_radius and scene.well.hole_bottom:  # the well's hole section at the bit
             bottoms = list(scene.well.hole_bottom)
-            k = next((i for i, b in enumerate(bottoms) if b >= scene.string_length * (1 - 1e-12)), len(bottoms) - 1)
+            k = next((i for i, b in enumerate(bottoms) if b >= scene.string_length - DEPTH_ROUND_OFF), len(bottoms) - 1)
             k = min(k, len(scene.well.hole_radius) - 1)
             hole_at_bit, which = scene.well.hole_radius[k], f"well.hole_radius[{k + 1}] (the hole at the bit)"
         if bit.bit_radius > hole_at_bit * (1 + 1e-9):
             raise SceneError(f"bit_rock.bit_radius = {bit.bit_radius!r} is not admissible: must be <= {which} = "
                              f"{hole_at_bit!r} (the bit cuts the hole)")
+        _check_bit_passes_its_bha(scene)
     if drive.mode == "hook_load":
         if not scene.model.bit_rock:
             raise SceneError("drive.mode = 'hook_load' is not admissible with model.bit_rock = false: nothing "
@@ -763,6 +765,30 @@ def _check_well_keys(scene: Scene) -> None:
         raise SceneError("torque_drag.operations = [] is not admissible: name at least one operation")
 
 
+def _check_bit_passes_its_bha(scene: Scene) -> None:
+    """The bit drills the hole its BHA runs in: a bit smaller than the largest outer radius (body or tool joint,
+    stabiliser blade) of a section in the hole section at the bit is refused, with the numbers.  (A section above
+    an under-reamer lies in a larger hole section of its own, and is not compared.)"""
+    sections, bit = scene.string.sections, scene.bit_rock.bit_radius
+    if not sections:
+        return
+    length = scene.string_length
+    bottoms = sorted(scene.well.hole_bottom)
+    top_of_bit_hole = max((b for b in bottoms if b < length - DEPTH_ROUND_OFF), default=0.0)
+    below = 0.0  # the depth of a section's bottom above the bit
+    for k, section in enumerate(sections, start=1):
+        radius = max(section["outer_radius"], section.get("tool_joint_outer_radius", 0.0))
+        if length - below <= top_of_bit_hole:
+            break
+        if bit < radius * (1 - 1e-9):
+            name = f" ({section['name']})" if section.get("name") else ""
+            raise SceneError(f"bit_rock.bit_radius = {bit!r} is not admissible: the bit must pass its BHA, and "
+                             f"string.sections[{k}]{name} is {radius!r} m in radius ({2 * radius / 0.0254:.4g} in "
+                             f"across) in the hole the bit drills; give the bit's radius (an 8 1/2 in bit: "
+                             "bit_radius = \"4 1/4 in\")")
+        below += section["length"]
+
+
 def _check_stabilisers(scene: Scene) -> None:
     """Each stabiliser inside the string, on a vertex of its own that no end support holds (a stabiliser holds the
     vertex nearest its position: one that snaps onto a held end, or onto another's vertex, would do nothing)."""
@@ -799,15 +825,40 @@ def validate(raw: dict[str, Any]) -> Scene:
         for name, value in entries.items():
             if name not in keys:
                 raise SceneError(f"unknown key {section}.{name}; known keys of [{section}]: {', '.join(keys)}")
-            if isinstance(value, str) and kinds[name] is float:
+            if isinstance(value, str) and kinds[name] is float or (
+                    isinstance(value, (list, tuple)) and any(isinstance(v, str) for v in value) and name != "sections"):
                 written[f"{section}.{name}"] = value
-            if section == "string" and name == "sections" and isinstance(value, (list, tuple)):
-                value = [_section_in_si(k, table, written) for k, table in enumerate(value, start=1)]
-            values[name] = _coerce(f"{section}.{name}", value, kinds[name], keys[name].metadata)
+            try:
+                if section == "string" and name == "sections" and isinstance(value, (list, tuple)):
+                    value = [_section_in_si(k, table, written) for k, table in enumerate(value, start=1)]
+                values[name] = _coerce(f"{section}.{name}", value, kinds[name], keys[name].metadata)
+            except SceneError as err:
+                raise SceneError(quoting_written(str(err), written)) from None
         sections[section] = SECTIONS[section](**values)
-    scene = _check_relations(Scene(**sections))
+    try:
+        scene = _check_relations(Scene(**sections))
+    except SceneError as err:
+        raise SceneError(quoting_written(str(err), written)) from None
     object.__setattr__(scene, "written", written)  # what the user wrote with a unit (``fenics-drill scene``)
     return scene
+
+
+def quoting_written(message: str, written: dict[str, Any]) -> str:
+    """``message`` with what the user wrote for each key it names that was written with a unit, so that a bound
+    broken by a misread value names the text it was read from: ``... (string.sections[1].outer_diameter was
+    written '6 3/4 in')``."""
+    quoted = []
+    for name, text in written.items():
+        if repr(text) in message or (isinstance(text, (list, tuple)) and repr(list(text)) in message):
+            continue  # the message quotes it already
+        where, _, short = name.rpartition(".")
+        named = re.search(rf"(?<![\w.]){re.escape(name)}(?!\w)", message)
+        if not named and where.startswith("string.sections[") and message.startswith(where):
+            shorts = {short, SECTION_DIAMETERS.get(short, short)}
+            named = any(re.search(rf"(?<!\w){re.escape(n)}(?!\w)", message) for n in shorts)
+        if named:
+            quoted.append(f"{name} was written {text!r}")
+    return f"{message} ({'; '.join(quoted)})" if quoted else message
 
 
 def unused_keys(scene: Scene) -> set[str]:
@@ -908,16 +959,30 @@ def load_scene(path: str | Path | None = None, overrides: list[str] | tuple[str,
     raw: dict[str, Any] = {}
     if path is not None:
         raw = _read_toml(Path(path))
-        survey = raw.get("well", {}).get("survey") if isinstance(raw.get("well"), dict) else None
-        if isinstance(survey, str) and survey and not Path(survey).is_absolute():
-            raw["well"]["survey"] = str(Path(path).resolve().parent / survey)  # relative to the scene file
+        _anchor_files(raw, Path(os.path.abspath(path)).parent)  # a scene file's paths: relative to the file
     for text in overrides:
         section, name, value = parse_override(text)
         raw.setdefault(section, {})
         if not isinstance(raw[section], dict):
             raise SceneError(f"[{section}] must be a table of keys")
         raw[section][name] = value
+        _anchor_files({section: {name: value}}, Path.cwd(), into=raw)  # a command line's: to where it runs
     return validate(raw)
+
+
+#: The scene keys that name files: (section, key).
+FILE_KEYS = (("well", "survey"),)
+
+
+def _anchor_files(raw: dict, folder: Path, into: dict | None = None) -> None:
+    """Make the relative paths of :data:`FILE_KEYS` in ``raw`` absolute from ``folder`` (written into ``into``,
+    default ``raw``), so that no later reading depends on the working directory."""
+    into = raw if into is None else into
+    for section, name in FILE_KEYS:
+        table = raw.get(section)
+        value = table.get(name) if isinstance(table, dict) else None
+        if isinstance(value, str) and value and not Path(value).is_absolute():
+            into[section][name] = str(folder / value)
 
 
 @dataclass(frozen=True)

@@ -6,10 +6,12 @@
 * A directory that already holds the output of the same command is refused unless the
   user says ``--overwrite`` (then every file that command wrote is removed first, and
   nothing else) or, for a study, ``--resume`` (continue it).
-* What a command wrote is known from a record, ``.fenics-drill-files.json``: the names of the entries it created
-  in the directory (its outputs, named before it starts; what else appeared while it held the directory; the
-  figures drawn from it), and their temporary files ``.NAME.tmpPID``.  A file is never removed because of its
-  name: a user's ``figure_from_colleague.png`` or ``.notes.tmp.txt`` is not in the record.  A directory written
+* What a command wrote is known from a record, ``.fenics-drill-files.json``: the names of the entries it writes
+  in the directory (its outputs, named before it starts, and the figures drawn from it), and their temporary
+  files ``.NAME.tmpPID``.  Only what the command itself names is recorded: a file that appears in the directory
+  while the command runs (a user's notes saved there) is not the command's, and ``--overwrite`` leaves it and says
+  so.  A file is never removed because of its name either: a user's ``figure_from_colleague.png`` or
+  ``.notes.tmp.txt`` is not in the record.  A directory written
   before the record existed is read by the exact names of its command's outputs.
 * A directory with files that are not a command's output is never touched.
 * One process at a time: an exclusive lock (``.fenics-drill.lock``, released by the
@@ -188,9 +190,8 @@ def _foreign(out: Path, command: str | None) -> list[Path]:
 class OutputClaim:
     """An output directory held by this process: the lock stays until :meth:`release` or exit."""
 
-    def __init__(self, out: Path, command: str, lock_file, before: set[str] | None = None):
+    def __init__(self, out: Path, command: str, lock_file):
         self.out, self.command, self._lock = out, command, lock_file
-        self._before = before  # the entries of ``out`` when it was claimed (None: a claim that records nothing)
 
     def __enter__(self) -> "OutputClaim":
         return self
@@ -199,21 +200,14 @@ class OutputClaim:
         self.release()
 
     def release(self) -> None:
-        """Record what appeared in the directory while it was held and give it back, removing the lock file
-        (idempotent; a claim without a lock, as on MPI ranks > 0, holds nothing)."""
+        """Give the directory back, removing the lock file (idempotent; a claim without a lock, as on MPI ranks
+        > 0, holds nothing)."""
         if self._lock is None:
             return
-        try:
-            if self._before is not None and self.out.is_dir():
-                appeared = {p.name for p in self.out.iterdir() if not TEMPORARY.match(p.name)} - self._before
-                record_written(self.out, appeared)
-        except OSError:
-            pass  # a full disk or a removed directory: the record keeps what it had
-        finally:
-            (self.out / LOCK_NAME).unlink(missing_ok=True)  # before unlocking: see _lock for the race
-            fcntl.flock(self._lock, fcntl.LOCK_UN)
-            self._lock.close()
-            self._lock = None
+        (self.out / LOCK_NAME).unlink(missing_ok=True)  # before unlocking: see _lock for the race
+        fcntl.flock(self._lock, fcntl.LOCK_UN)
+        self._lock.close()
+        self._lock = None
 
 
 def _lock(out: Path):
@@ -287,8 +281,7 @@ def claim_output(out: str | Path, command: str, overwrite: bool = False, resume:
             for path in owned_paths(out, command):
                 shutil.rmtree(path) if path.is_dir() else path.unlink()
         remove_figures(out)
-        before = {p.name for p in out.iterdir()}
-        record_written(out, [name for name in OWNED[command] if name not in before])  # named before they exist
+        record_written(out, [name for name in OWNED[command] if not (out / name).exists()])  # named before they exist
         write_json(out / "summary.json", {"command": command, "status": "running", "pid": os.getpid(),
                                           "host": socket.gethostname(),
                                           "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), **(record or {})})
@@ -297,7 +290,7 @@ def claim_output(out: str | Path, command: str, overwrite: bool = False, resume:
         lock.close()
         _leave_nothing(out, created_dir, created_lock)
         raise
-    return OutputClaim(out, command, lock, before)
+    return OutputClaim(out, command, lock)
 
 
 def _leave_nothing(out: Path, created_dir: bool, created_lock: bool) -> None:

@@ -10,6 +10,7 @@ Coordinates: x north, y east, z up (true vertical depth is -z); the tangent poin
 from __future__ import annotations
 
 import csv
+import dataclasses
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,7 +19,7 @@ import numpy as np
 
 from fenics_drill.model.string_sections import section_at, string_sections
 from fenics_drill.scene import SceneError, read_regular_file
-from fenics_drill.units import UnitError, to_si
+from fenics_drill.units import DEPTH_ROUND_OFF, UnitError, read_number, read_quantity
 
 #: Largest dogleg a pipe can pass in a well [deg per 30 m]: beyond this a survey is refused as a typing error
 #: (the tightest short-radius wells build at about 2-3 deg per metre).
@@ -43,6 +44,7 @@ class Survey:
     md: np.ndarray
     inclination: np.ndarray
     azimuth: np.ndarray
+    notes: tuple[str, ...] = ()  # what the reader left out of the file, said once the survey is read
 
     @classmethod
     def of(cls, md, inclination_deg, azimuth_deg, where: str = "the survey") -> "Survey":
@@ -83,13 +85,16 @@ class Survey:
 
 #: The largest survey file read [bytes] (100 000 stations take about 3 MB).
 MAX_SURVEY_BYTES = 50_000_000
-#: The names each survey column goes by in a header (lowercase, its unit left out).
-SURVEY_COLUMNS = {"md": ("md", "measured depth", "measured_depth", "measureddepth", "depth"),
+#: The names each survey column goes by in a header (lowercase, its unit and north reference left out).
+SURVEY_COLUMNS = {"md": ("md", "measured depth", "measured_depth", "measureddepth", "depth", "mdepth"),
                   "inclination": ("inclination", "inc", "incl"),
                   "azimuth": ("azimuth", "azi", "az", "azim")}
-#: What each survey column is read in: its header's unit (pint's, :mod:`fenics_drill.units`) converted to these.
+#: What each survey column is read in: its header's unit (:mod:`fenics_drill.units`) converted to these.
 SURVEY_UNITS = {"md": "m", "inclination": "degree", "azimuth": "degree"}
-_UNIT = re.compile(r"^(?P<name>.*?)\s*[(\[]\s*(?P<unit>[^()\[\]]*?)\s*[)\]]\s*$")
+#: The north an azimuth column is referred to, by the words vendors write beside it (in its name or in brackets).
+NORTH_REFERENCES = {"true": "true", "tn": "true", "t": "true", "grid": "grid", "gn": "grid", "g": "grid",
+                    "mag": "magnetic", "magnetic": "magnetic", "mn": "magnetic", "m": "magnetic"}
+_BRACKETS = re.compile(r"\s*[(\[]\s*([^()\[\]]*?)\s*[)\]]")
 
 
 def _survey_text(path: Path) -> str:
@@ -111,28 +116,83 @@ def _survey_text(path: Path) -> str:
     return text
 
 
-def _survey_column(header: str, path: Path) -> tuple[str | None, float]:
-    """(the survey column a header cell names, or None; the factor of its unit to m or degrees)."""
+@dataclass(frozen=True)
+class SurveyColumn:
+    """A header cell that names a survey column: which one, the factor of its unit to m or degrees, and (an
+    azimuth) the north it is referred to ('true', 'grid', 'magnetic'; None where the header does not say)."""
+
+    column: str
+    factor: float
+    north: str | None = None
+
+
+def _survey_column(header: str, path: Path) -> SurveyColumn | None:
+    """The survey column a header cell names (``MD (ft)``, ``Azim True (deg)``, ``Azi (grid)``), or None."""
     cell = header.strip().strip('"').strip()
-    match = _UNIT.match(cell)
-    name, unit = (match["name"], match["unit"]) if match else (cell, "")
-    name, unit = " ".join(name.lower().split()), unit.strip().lower()
+    bracketed = _BRACKETS.findall(cell)
+    words = _BRACKETS.sub(" ", cell).lower().replace("_", " ").split()
+    north = None
+    for word in list(words[1:]) + [b.lower() for b in bracketed]:
+        if word in NORTH_REFERENCES:
+            north = NORTH_REFERENCES[word]
+    words = [w for w in words if not (w in NORTH_REFERENCES and w != words[0])]
+    units = [b for b in bracketed if b.lower() not in NORTH_REFERENCES]
+    name = " ".join(words)
     for column, aliases in SURVEY_COLUMNS.items():
         if name in aliases:
-            if not unit:
-                return column, 1.0
+            if column != "azimuth":
+                north = None
+            if not units or not units[0].strip():
+                return SurveyColumn(column, 1.0, north)
+            unit = units[0].strip()
             try:
-                return column, to_si(f"1 {'degree' if unit == '°' else unit}", SURVEY_UNITS[column])
+                return SurveyColumn(column, read_quantity(f"1 {'degree' if unit == '°' else unit}",
+                                                          SURVEY_UNITS[column]), north)
             except UnitError as err:
                 raise SurveyError(f"survey file {path}: column {cell!r}: {err}") from None
-    return None, 1.0
+    return None
+
+
+def _survey_columns(names: list[str], path: Path, header_line: int) -> tuple[dict[str, tuple[int, float]], list[str]]:
+    """The index and unit factor of each survey column in a header, and notices of the columns left out: of
+    several azimuths the true one (or the one that names no north) is read; a grid or magnetic azimuth alone is
+    refused, since it needs the grid convergence or the declination, which a survey file does not carry."""
+    found, azimuths, notes = {}, [], []
+    for index, cell in enumerate(names):
+        column = _survey_column(cell, path)
+        if column is None:
+            continue
+        if column.column == "azimuth":
+            azimuths.append((index, column, cell.strip()))
+        elif column.column not in found:
+            found[column.column] = (index, column.factor)
+    if azimuths:
+        rank = {"true": 0, None: 1}
+        usable = sorted((a for a in azimuths if a[1].north in rank), key=lambda a: rank[a[1].north])
+        if not usable:
+            index, column, cell = azimuths[0]
+            raise SurveyError(f"survey file {path}, line {header_line}: the only azimuth, {cell!r}, is referred to "
+                              f"{column.north} north; give the azimuth to true north (a {column.north} azimuth needs "
+                              f"the {'grid convergence' if column.north == 'grid' else 'magnetic declination'}, "
+                              "which the file does not carry)")
+        index, column, cell = usable[0]
+        found["azimuth"] = (index, column.factor)
+        notes += [f"survey file {path}: column {other!r} left out, {cell!r} read as the azimuth"
+                  for i, _, other in azimuths if i != index]
+    missing = [c for c in SURVEY_COLUMNS if c not in found]
+    if missing:
+        shown = ", ".join(repr(n.strip()) for n in names)
+        raise SurveyError(f"survey file {path}, line {header_line}: no column {', '.join(missing)} (the header names "
+                          f"{shown}); the columns are md [m or ft], inclination and azimuth [deg]")
+    return found, notes
 
 
 def read_survey_csv(path: Path) -> Survey:
-    """A survey from a CSV file: a header naming the columns md, inclination and azimuth (or MD, Inc, Azi, with
-    their units in brackets: m or ft, deg or rad; other columns are ignored), then one station per line; commas,
-    semicolons or tabs between the fields; lines starting with # and blank lines are skipped.  Errors name the
-    file and the line."""
+    """A survey from a CSV file: a header naming the columns md, inclination and azimuth (or MD, Inc, Azi, Azim
+    True, with their units in brackets: m or ft, deg or rad; other columns are ignored), then one station per
+    line; commas, semicolons or tabs between the fields (with semicolons or tabs, a decimal comma is read); lines
+    starting with # and blank lines are skipped.  Errors name the file and the line; the columns left out are in
+    the survey's ``notes``."""
     lines = [(k, line) for k, line in enumerate(_survey_text(path).splitlines(), start=1)
              if line.strip() and not line.lstrip().startswith("#")]
     if not lines:
@@ -140,16 +200,7 @@ def read_survey_csv(path: Path) -> Survey:
     header_line, header = lines[0]
     delimiter = next((d for d in (",", ";", "\t") if d in header), ",")
     names = next(csv.reader([header], delimiter=delimiter))
-    found = {}
-    for index, cell in enumerate(names):
-        column, factor = _survey_column(cell, path)
-        if column is not None and column not in found:
-            found[column] = (index, factor)
-    missing = [c for c in SURVEY_COLUMNS if c not in found]
-    if missing:
-        shown = ", ".join(repr(n.strip()) for n in names)
-        raise SurveyError(f"survey file {path}, line {header_line}: no column {', '.join(missing)} (the header names "
-                          f"{shown}); the columns are md [m or ft], inclination and azimuth [deg]")
+    found, notes = _survey_columns(names, path, header_line)
     values = {c: [] for c in SURVEY_COLUMNS}
     for k, line in lines[1:]:
         fields = next(csv.reader([line], delimiter=delimiter))
@@ -158,13 +209,14 @@ def read_survey_csv(path: Path) -> Survey:
                               f"{len(names)}")
         for column, (index, factor) in found.items():
             try:
-                values[column].append(float(fields[index]) * factor)
-            except ValueError:
+                values[column].append(read_number(fields[index], decimal_comma=delimiter != ",") * factor)
+            except UnitError:
                 raise SurveyError(f"survey file {path}, line {k}: {column} = {fields[index].strip()!r} is not a "
                                   "number") from None
     if not values["md"]:
         raise SurveyError(f"survey file {path} holds a header but no stations")
-    return Survey.of(values["md"], values["inclination"], values["azimuth"], where=f"survey file {path}")
+    survey = Survey.of(values["md"], values["inclination"], values["azimuth"], where=f"survey file {path}")
+    return dataclasses.replace(survey, notes=tuple(notes))
 
 
 class Trajectory:
@@ -331,6 +383,11 @@ class Well:
         """Measured depth of the last survey station (total depth) [m]."""
         return float(self.trajectory.md[-1])
 
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """What the survey's reader left out of its file (a second azimuth column, ...)."""
+        return self.trajectory.survey.notes
+
 
 def well_of(scene, string_length: float) -> Well:
     """The well of a scene's ``[well]`` table (raises SceneError naming the key, the file or the station): the
@@ -366,7 +423,7 @@ def well_of(scene, string_length: float) -> Well:
         if np.any(np.diff(bottoms) <= 0) or bottoms[0] <= 0:
             raise SceneError(f"well.hole_bottom = {list(w.hole_bottom)} is not admissible: the sections' bottoms "
                              "must be > 0 and increasing")
-        if bottoms[-1] < depth:
+        if bottoms[-1] < depth - DEPTH_ROUND_OFF:
             raise SceneError(f"well.hole_bottom = {list(w.hole_bottom)} is not admissible: the last section must "
                              f"reach the survey's last station at md = {depth:g} m")
         if np.any(radii <= 0):
@@ -374,7 +431,7 @@ def well_of(scene, string_length: float) -> Well:
         cased = np.asarray(w.hole_cased or [False] * count, dtype=bool)
     else:
         bottoms, radii, cased = np.array([depth]), np.array([scene.borehole.radius]), np.array([False])
-    if string_length > depth * (1 + 1e-9):
+    if string_length > depth + DEPTH_ROUND_OFF:
         raise SceneError(f"the string ({string_length:g} m) is longer than the well ({depth:g} m of measured depth): "
                          "shorten string.sections or extend the survey")
     trajectory = Trajectory(survey)
@@ -406,12 +463,54 @@ def hanging_tension(scene, md, weight_on_bit: float) -> np.ndarray:
 
 
 def check_weight_on_bit(scene) -> None:
-    """Refuse a weight on bit that the string's weight in a well cannot give (SceneError with the numbers): the hook
-    would have to push it down.  The paper's horizontal string is pushed by design and is not checked."""
-    if not (scene.well.survey or scene.well.md) or not (scene.starts_on_bottom or scene.drive.mode == "hook_load"):
+    """Refuse a weight on bit that a hook-load drive cannot set in a well (SceneError with the numbers): a drawworks
+    only holds, and the weight on bit cannot exceed the string's buoyed weight along the axis.  Both the drive's and
+    the modal analysis's (``modal.weight_on_bit``) are checked.  A velocity drive positions the top, and pushes where
+    the weight on bit asks more than the string weighs (its static state reports the push); the paper's horizontal
+    string is pushed by design.  Neither is checked."""
+    if not (scene.well.survey or scene.well.md) or scene.drive.mode != "hook_load":
         return
     available = float(hanging_tension(scene, [0.0], 0.0)[0])
-    if scene.drive.weight_on_bit >= available:
-        raise SceneError(f"drive.weight_on_bit = {scene.drive.weight_on_bit:g} N is not admissible: the string's "
-                         f"buoyed weight along this well is {available:.6g} N, so the hook would have to push to set "
-                         "it; lower the weight on bit, or add collars or heavy-weight pipe")
+    for name, value in (("drive.weight_on_bit", scene.drive.weight_on_bit),
+                        ("modal.weight_on_bit", scene.modal.weight_on_bit)):
+        if value >= available:
+            raise SceneError(f"{name} = {value:g} N is not admissible with drive.mode = 'hook_load': the string's "
+                             f"buoyed weight along this well is {available:.6g} N, so the hook would have to push to "
+                             "set it; lower the weight on bit, add collars or heavy-weight pipe, or drive the top "
+                             "(drive.mode = 'velocity')")
+
+
+def check_string_in_well(scene) -> Well | None:
+    """Every check of a scene's string in its well that needs no solve (what ``fenics-drill scene`` runs, and every
+    command before it computes): the survey and the hole sections (:func:`well_of`), the sections' buoyed weights
+    (:func:`~fenics_drill.model.string_sections.string_sections`) and the weight on bit (:func:`check_weight_on_bit`).
+    The well, or None for the paper's straight hole of one pipe."""
+    if not (scene.well.survey or scene.well.md or scene.string.sections):
+        return None
+    well = well_of(scene, string_sections(scene)[-1].bottom)
+    check_weight_on_bit(scene)
+    return well
+
+
+def bit_above_bottom(scene) -> float:
+    """How far the bit is above the well's bottom [m]: the well's measured depth less the string's length, 0 where
+    they agree within DEPTH_ROUND_OFF and in the paper's straight hole (as long as its string)."""
+    if not (scene.well.survey or scene.well.md):
+        return 0.0
+    length = string_sections(scene)[-1].bottom
+    gap = well_of(scene, length).depth - length
+    return gap if gap > DEPTH_ROUND_OFF else 0.0
+
+
+def well_notes(scene) -> list[str]:
+    """What every command says of a scene's well besides its results: where the bit is when the string does not
+    reach the well's bottom, and what the survey's reader left out of its file."""
+    well = check_string_in_well(scene)
+    if well is None:
+        return []
+    notes = list(well.notes)
+    above = bit_above_bottom(scene)
+    if above > 0:
+        notes.insert(0, f"the bit is {above:.4g} m above the well's bottom (a {string_sections(scene)[-1].bottom:.6g} m "
+                        f"string in a {well.depth:.6g} m well): 'on bottom' means the bit on the rock there")
+    return notes

@@ -38,3 +38,20 @@ def helical_load(stiffness, weight, inclination, clearance, curvature=0.0):
     vertical = 5.55 * np.cbrt(np.asarray(stiffness, dtype=float) * np.asarray(weight, dtype=float)**2)
     inclined = np.sqrt(2.0) * sinusoidal
     return np.maximum(inclined, vertical)
+
+
+def buckled_spans(md_element: np.ndarray, lengths: np.ndarray, compression: np.ndarray, sinusoidal: np.ndarray,
+                  helical: np.ndarray) -> dict:
+    """Where elements (mid-depths ``md_element``, ``lengths``) under ``compression`` [N] exceed their sinusoidal or
+    helical buckling loads: the lengths buckled each way [m], the first and last buckled mid-depth (None: none), the
+    largest compression and, at that element, the two loads [N]."""
+    sin = (compression > sinusoidal) & (compression <= helical)
+    hel = compression > helical
+    either = sin | hel
+    worst = int(np.argmax(compression))
+    return {"sinusoidally_buckled_length_m": float(lengths[sin].sum()),
+            "helically_buckled_length_m": float(lengths[hel].sum()),
+            "first_buckled_md_m": float(md_element[either][0]) if either.any() else None,
+            "last_buckled_md_m": float(md_element[either][-1]) if either.any() else None,
+            "max_compression_N": float(max(compression.max(), 0.0)),
+            "buckling_loads_at_max_compression_N": [float(sinusoidal[worst]), float(helical[worst])]}

@@ -61,8 +61,10 @@ def solve_static(model: DrillstringModel, tolerance: float = 1e-8, max_iteration
 
     From the straight string with wall contact, the wall springs are stiffened stage by stage
     (:data:`FIRST_STAGE`, :data:`STAGE_STEP`) on copies of the model; the model itself is left as it was.  On a
-    well, first one Newton solve with the real wall from :func:`resting_guess`.  From an ``initial`` guess near the
-    equilibrium (the full-order state projected on a reduced basis), one Newton solve with the real wall."""
+    well, first one Newton solve with the real wall from :func:`resting_guess`; where that fails for a string whose bit
+    is pressed (an axial tip load), the load raised in steps from the string resting off bottom
+    (:func:`_pressed_by_steps`).  From an ``initial`` guess near the equilibrium (the full-order state projected on a
+    reduced basis), one Newton solve with the real wall."""
     model = model.at_rest()  # both drive dofs held, whatever drives the run
     wall = model.force("wall")
     q, mu = (np.zeros(model.size) if initial is None else initial), np.zeros(2)
@@ -74,7 +76,50 @@ def solve_static(model: DrillstringModel, tolerance: float = 1e-8, max_iteration
             return _newton(model, resting, mu, tolerance, max_iterations)
         except StaticFailure:  # (a string the soft string leaves near the axis): the stages from the straight one
             pass
+    pressed = model.force("axial_tip_load")
+    if pressed is not None and pressed.force != 0.0:  # on bottom: from the string resting off bottom, pressed in steps
+        return _pressed_by_steps(model, pressed, tolerance, max_iterations)
     return _staged(model, wall, q, mu, tolerance, max_iterations)
+
+
+#: The weight on bit of a string on bottom is raised in steps of at most this share of it from the string resting off
+#: bottom when the solve at the whole weight fails; a step whose Newton fails within LOAD_STEP_ITERATIONS is halved,
+#: down to SMALLEST_LOAD_STEP of the weight.
+LOAD_STEP, SMALLEST_LOAD_STEP, LOAD_STEP_ITERATIONS = 1.0 / 8, 1.0 / 1024, 60
+
+
+class LoadNotCarried(StaticFailure):
+    """The weight on bit raised in steps found equilibria up to ``reached`` [N] of ``force`` [N], and none beyond: a
+    limit of the static path (a string that snaps into a helix in its hole)."""
+
+    def __init__(self, message: str, reached: float, force: float):
+        super().__init__(message)
+        self.reached, self.force = reached, force
+
+
+def _pressed_by_steps(model: DrillstringModel, pressed, tolerance: float, max_iterations: int) -> StaticEquilibrium:
+    """The equilibrium with the bit pressed by ``pressed.force``, reached from the string resting off bottom by
+    raising the load in steps (:data:`LOAD_STEP`), each from the last equilibrium; LoadNotCarried names the largest
+    load carried where the steps stall."""
+    def at(force: float) -> DrillstringModel:
+        return model.with_force(type(pressed)(model.disc, model.space, force))
+
+    eq = solve_static(at(0.0))
+    reached, step, total = 0.0, LOAD_STEP * pressed.force, eq.iterations
+    while reached < pressed.force:
+        trial = min(reached + step, pressed.force)
+        try:
+            eq = _newton(at(trial), eq.q, eq.mu, tolerance,
+                         max_iterations if trial == pressed.force else LOAD_STEP_ITERATIONS)
+        except StaticFailure:
+            step *= 0.5
+            if step < SMALLEST_LOAD_STEP * pressed.force:
+                raise LoadNotCarried(f"static equilibrium not found with the bit pressed at {pressed.force / 1e3:.4g} "
+                                     f"kN: raised in steps from off bottom, the string rests in equilibrium up to "
+                                     f"{reached / 1e3:.4g} kN and none is found beyond", reached, pressed.force) from None
+            continue
+        reached, total, step = trial, total + eq.iterations, min(2.0 * step, LOAD_STEP * pressed.force)
+    return StaticEquilibrium(eq.q, eq.mu, total, eq.residual)
 
 
 def resting_guess(model: DrillstringModel) -> np.ndarray | None:
@@ -92,7 +137,8 @@ def resting_guess(model: DrillstringModel) -> np.ndarray | None:
     weights = [s.buoyed_weight(g, scene.fluid.density, scene.inner_fluid_density) for s in sections]
     well = well_of(scene, sections[-1].bottom)
     mesh = string_mesh(well, sections, float(np.diff(disc.vertex_x).min()), weights, 0.0, 0.0)
-    rest = soft_string(mesh, Operation("at rest", 0.0, 0.0, 0.0, 0.0))
+    pressed = model.force("axial_tip_load")  # a string on bottom: the bit pressed with the weight on bit
+    rest = soft_string(mesh, Operation("at rest", 0.0, 0.0, -pressed.force if pressed is not None else 0.0, 0.0))
     dofs = np.zeros(disc.ndofs)
     element = lambda x: np.clip(np.searchsorted(mesh.md, x) - 1, 0, mesh.md.size - 2)  # noqa: E731
     for field, axis in ((V, "d2"), (W, "d3")):

@@ -107,6 +107,14 @@ def uninterrupted(stop_after: bool = True, comm=None):
         raise KeyboardInterrupt
 
 
+def scene_record(scene) -> dict:
+    """What every command's summary.json says of its scene's well: where the bit is against the well's bottom
+    (``bit_above_well_bottom_m``) and the notes of :func:`~fenics_drill.model.well.well_notes`."""
+    from fenics_drill.model.well import bit_above_bottom, well_notes
+
+    return {"bit_above_well_bottom_m": bit_above_bottom(scene), "notes": well_notes(scene)}
+
+
 @contextmanager
 def command_output(out: str | Path, command: str, scene, overwrite: bool = False):
     """Check that the scene fits in memory (ResourceError), take ``out`` for ``command`` (OutputError),
@@ -117,7 +125,7 @@ def command_output(out: str | Path, command: str, scene, overwrite: bool = False
     check_memory(scene.beam.elements, scene.beam.element_degree)
     claim = claim_output(out, command, overwrite)
     start = time.perf_counter()
-    summary = {"command": command, "status": "finished", "message": ""}
+    summary = {"command": command, "status": "finished", "message": "", **scene_record(scene)}
     try:
         with StopOnSignal():
             try:

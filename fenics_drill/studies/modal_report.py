@@ -22,8 +22,10 @@ from fenics_drill.model.operators import assemble_linear
 from fenics_drill.model.reduction.modes import (ModalBasis, drive_held_modes, family_counts, select_modes,
                                                 solve_modes, stuck_bit_modes)
 from fenics_drill.model.reduction.spaces import solution_space
+from fenics_drill.model.well import check_string_in_well
 from fenics_drill.studies.lifecycle import command_output
-from fenics_drill.studies.operating_state import linearised_state, loaded_stiffness, operating_state
+from fenics_drill.studies.operating_state import (REPORTED_MODES, buckled_modes, linearised_state, loaded_stiffness,
+                                                  operating_state)
 
 #: The end conditions of each spectrum: the (field, end) pairs held besides the supports, and how they read.
 SPECTRA = {
@@ -60,14 +62,15 @@ def _spectra(scene, disc, operators, free: ModalBasis, loaded) -> dict:
             "drive_held_bit_stuck": both.select(np.argsort(both.frequencies_hz, kind="stable"))}
 
 
-def spectra_summary(spectra: dict) -> dict:
+def spectra_summary(spectra: dict, buckled: bool = False) -> dict:
     """The drilling engineer's reading of the spectra: the first torsional mode of the drive-held string with the
     bit off bottom (its period, the time scale of torsional stick-slip) and the synchronous critical speeds of its
-    first lateral modes (rotation speed = lateral frequency, order 1)."""
+    first lateral modes (rotation speed = lateral frequency, order 1); none for a ``buckled`` string, which has no
+    critical speed."""
     held = spectra["drive_held_bit_off_bottom"]
     kinds = np.array(held.kinds)
-    torsional = held.frequencies_hz[kinds == "torsional"]
-    lateral = held.frequencies_hz[kinds == "flexural"][:CRITICAL_SPEEDS]
+    torsional = held.frequencies_hz[(kinds == "torsional") & (held.frequencies_hz > 0)]
+    lateral = [] if buckled else held.frequencies_hz[kinds == "flexural"][:CRITICAL_SPEEDS]
     return {
         "first_torsional_frequency_hz": float(torsional[0]) if torsional.size else None,
         "first_torsional_period_s": float(1.0 / torsional[0]) if torsional.size else None,
@@ -75,11 +78,25 @@ def spectra_summary(spectra: dict) -> dict:
     }
 
 
+def buckling_report(buckled: list[dict], weight_on_bit: float) -> dict | None:
+    """What ``modal`` says of a buckled static state: the load, the modes without stiffness, where they bend."""
+    if not buckled:
+        return None
+    first = buckled[0]
+    return {"weight_on_bit_N": weight_on_bit, "mode_count": len(buckled), "modes": buckled[:REPORTED_MODES],
+            "message": f"the string is buckled at {weight_on_bit / 1e3:.4g} kN on the bit: {len(buckled)} mode(s) of "
+                       f"the drive-held string have no positive stiffness (the first, {first['kind']}, bends most "
+                       f"at {first['largest_lateral_displacement_at_m']:.0f} m); its static state is not stable and "
+                       "it has no critical speed: lower modal.weight_on_bit (the soft string's buckling loads: "
+                       "fenics-drill torque-drag)"}
+
+
 def modal_report(scene) -> dict:
     """full_dofs, every free-free mode (frequency_hz, f_star, kind, energy fractions), the spectra of the run's end
     conditions about the state ``modal.state`` chooses, the reduced basis (the modes the rule keeps of the same
     free-free spectrum, Table 4, the 'auto' rule's stuck-bit torsional modes, and the vectors the guard adds) and
     the guard's report."""
+    check_string_in_well(scene)
     disc = BeamDiscretization.from_scene(scene)
     operators = assemble_linear(disc)
     loaded, about = None, {"state": "unloaded"}
@@ -106,6 +123,10 @@ def modal_report(scene) -> dict:
         reduced = {"rule": scene.reduction.rule, "size": disc.ndofs, "counts": None, "mode_indices": None,
                    "unknowns": disc.ndofs, "guard": guard}
     free = spectra["free_free"]
+    p = disc.properties
+    buckled = buckling_report(buckled_modes(spectra["drive_held_bit_off_bottom"], p.length,
+                                            p.longitudinal_wave_speed), about.get("weight_on_bit_N", 0.0)) \
+        if loaded is not None else None
     return {
         "full_dofs": disc.ndofs,
         "element_degree": disc.element_degree,
@@ -117,7 +138,8 @@ def modal_report(scene) -> dict:
         "modes": _mode_rows(free),
         "spectra": {name: {"held": SPECTRA[name][1], "modes": _mode_rows(spectrum)}
                     for name, spectrum in spectra.items()},
-        **spectra_summary(spectra),
+        **spectra_summary(spectra, buckled is not None),
+        "buckled": buckled,
         "reduced_basis": reduced,
     }
 

@@ -18,12 +18,15 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from fenics_drill.model.discretization import DRIVE
 from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.model.forces.axial_tip_load import AxialTipLoad
 from fenics_drill.model.forces.wall_contact import WallContact
 from fenics_drill.model.operators import assemble_geometric_stiffness
+from fenics_drill.model.reduction.modes import solve_modes
 from fenics_drill.model.reduction.spaces import FullSpace
-from fenics_drill.solvers.static import solve_static
+from fenics_drill.solvers.static import LoadNotCarried, StaticFailure, solve_static
+from fenics_drill.studies.torque_drag import buckling_on_bottom
 
 
 @dataclass
@@ -50,13 +53,23 @@ def operating_state(scene, disc, operators, weight_on_bit: float, on_wall: bool)
     if not model.forces:
         return OperatingState(np.zeros(disc.ndofs), {"state": state, "newton_iterations": 0,
                                                      "weight_on_bit_N": weight_on_bit}, False)
-    equilibrium = solve_static(model)
+    equilibrium = solve_pressed(model, scene, weight_on_bit)
     displacement = model.space.expand(equilibrium.q)
     wall = model.force("wall")
     in_contact = int(wall.evaluate(equilibrium.q, np.zeros_like(equilibrium.q)).in_contact.sum()) if wall else 0
     return OperatingState(displacement, {"state": state, "newton_iterations": equilibrium.iterations,
                                          "vertices_on_the_wall": in_contact, "weight_on_bit_N": weight_on_bit},
                           in_contact > 0)
+
+
+def solve_pressed(model: DrillstringModel, scene, weight_on_bit: float, initial=None):
+    """:func:`~fenics_drill.solvers.static.solve_static` of ``model`` with its bit pressed at ``weight_on_bit`` [N]; a
+    weight it cannot carry is refused with what the soft string says of the string at that weight (where it is
+    buckled)."""
+    try:
+        return solve_static(model, initial=initial)
+    except LoadNotCarried as failure:
+        raise StaticFailure(f"{failure}; {buckling_on_bottom(scene, weight_on_bit)}") from None
 
 
 def loaded_stiffness(scene, disc, operators, state: OperatingState) -> sp.csr_matrix:
@@ -71,6 +84,46 @@ def loaded_stiffness(scene, disc, operators, state: OperatingState) -> sp.csr_ma
     springs = sp.csr_matrix(wall.tangent(wall.evaluate(q, np.zeros_like(q), with_tangent=True), 1.0, 0.0))
     embed = sp.csr_matrix((np.ones(space.size), (space.free, np.arange(space.size))), shape=(disc.ndofs, space.size))
     return (stiffness - embed @ springs @ embed.T).tocsr()
+
+
+#: A mode of the drive-held string whose omega^2 is below (2 pi f* c_L / L)^2 at this f* has lost its stiffness: the
+#: string is buckled (round-off leaves the free-free string's rigid modes near f* = 1e-5; the drive holds them).
+BUCKLED_F_STAR = 1e-4
+
+
+#: The modes without stiffness a report lists (the lowest; their count is given beside).
+REPORTED_MODES = 4
+
+
+def buckled_modes(held, length: float, wave_speed: float) -> list[dict]:
+    """The modes of the drive-held spectrum whose stiffness vanishes or is negative (omega^2 <= (2 pi BUCKLED_F_STAR
+    c_L / L)^2): their index, kind, omega^2 [1/s^2] and where each bends most (x of its largest lateral
+    displacement, the measured depth in a well)."""
+    if held.eigenvalues is None:
+        return []
+    limit = (2.0 * np.pi * BUCKLED_F_STAR * wave_speed / length) ** 2
+    return [{"index": int(i), "kind": held.kinds[i], "omega_squared": float(held.eigenvalues[i]),
+             "largest_lateral_displacement_at_m": float(held.lateral_peak_x[i])}
+            for i in np.flatnonzero(held.eigenvalues <= limit)]
+
+
+def unstable_modes(scene, model: DrillstringModel, q: np.ndarray) -> list[dict]:
+    """The modes of the drive-held string that have no positive stiffness about the static state ``q`` of ``model``
+    (:func:`buckled_modes` of the prestressed tangent, :func:`loaded_stiffness`; the band up to
+    STABILITY_F_STAR): none where the state is stable."""
+    disc = model.disc
+    displacement = model.space.expand(q)
+    wall = model.force("wall")
+    on_wall = bool(wall is not None and wall.evaluate(q, np.zeros_like(q)).in_contact.any())
+    state = OperatingState(displacement, {}, on_wall)
+    stiffness = loaded_stiffness(scene, disc, model.operators, state)
+    held = solve_modes(disc, STABILITY_F_STAR, model.operators.mass, held=DRIVE, vectors=False, stiffness=stiffness)
+    p = disc.properties
+    return buckled_modes(held, p.length, p.longitudinal_wave_speed)
+
+
+#: The band in which a static state's stability is judged (its lowest modes): f* = f L / c_L <= this.
+STABILITY_F_STAR = 0.2
 
 
 def linearised_state(scene) -> str:

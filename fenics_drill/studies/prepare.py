@@ -18,7 +18,7 @@ import numpy as np
 
 from fenics_drill.model.drillstring import DrillstringModel, build_model
 from fenics_drill.model.forces.axial_tip_load import AxialTipLoad
-from fenics_drill.model.well import check_weight_on_bit
+from fenics_drill.model.well import check_string_in_well
 from fenics_drill.model.reduction.enrichment import (basis_error, bit_loads, missed_share, tangent_responses,
                                                      wall_friction_loads)
 from fenics_drill.model.reduction.hyper_reduction import train_sample
@@ -30,7 +30,7 @@ from fenics_drill.solvers.static import StaticEquilibrium, StaticFailure, solve_
 from fenics_drill.solvers.step_control import RunFailure
 from fenics_drill.solvers.time_loop import Simulation
 from fenics_drill.studies.lifecycle import uninterrupted
-from fenics_drill.studies.operating_state import prestressed_modes
+from fenics_drill.studies.operating_state import prestressed_modes, solve_pressed
 
 #: Time histories kept per realisation (Figs. 29, 31, 33).
 HISTORIES = ("bit_displacement", "bit_velocity", "bit_rotation", "bit_angular_velocity", "section_w",
@@ -61,7 +61,7 @@ def prepare(scene, dynamics: bool = True, stage=lambda name: None) -> PreparedSc
     A scene that starts on bottom (:attr:`~fenics_drill.scene.Scene.starts_on_bottom`) rests with the bit pressed at
     ``drive.weight_on_bit`` (an axial load at the bit in the static solve); its static report's hook load is then
     the on-bottom one."""
-    check_weight_on_bit(scene)
+    check_string_in_well(scene)
     clock = time.perf_counter()
     stage("mesh, operators, modes and the solution space (a reduced basis or the full order)")
     model = build_model(scene, prestressed_modes(scene))
@@ -76,7 +76,7 @@ def prepare(scene, dynamics: bool = True, stage=lambda name: None) -> PreparedSc
     on_bottom = scene.drive.weight_on_bit if scene.starts_on_bottom else 0.0
     stage("the static equilibrium on the wall" + (f", the bit pressed at {on_bottom / 1e3:.4g} kN" if on_bottom else ""))
     resting = model if not on_bottom else model.with_added_force(AxialTipLoad(model.disc, model.space, on_bottom))
-    equilibrium = solve_static(resting, initial=initial)
+    equilibrium = solve_pressed(resting, scene, on_bottom, initial=initial)
     model = model.resting_at(equilibrium.q)
     static = {k: v for k, v in static_report(resting, equilibrium).items() if k != "contact_vertices"}
     static["weight_on_bit"] = on_bottom

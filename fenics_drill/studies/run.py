@@ -28,6 +28,7 @@ from fenics_drill.model.discretization import THETA_X, THETA_Y, THETA_Z, U, V, W
 from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.model.reduction.modes import drive_held_modes
 from fenics_drill.model.resources import check_disk, check_memory
+from fenics_drill.observables.buckling import buckled_spans
 from fenics_drill.observables.drilling_quantities import drilling_quantities, spin_variation_ratio
 from fenics_drill.observables.step_rows import StepRows
 from fenics_drill.observables.torque_drag import string_profiles, top_loads
@@ -38,7 +39,8 @@ from fenics_drill.model.resolution import band_frequency, mesh_advice
 from fenics_drill.solvers.step_control import (RunFailure, check_run_length, least_steps, nominal_step,
                                               steps_per_band_period)
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
-from fenics_drill.studies.lifecycle import StopOnSignal, command_output, uninterrupted
+from fenics_drill.studies.lifecycle import StopOnSignal, command_output, scene_record, uninterrupted
+from fenics_drill.studies.operating_state import REPORTED_MODES, unstable_modes
 from fenics_drill.studies.prepare import prepare
 from fenics_drill.studies.shared_run import check_ranks, check_same_state, second_rank_run, shared_model
 from fenics_drill.studies.torque_drag import fe_static_profiles, write_path_vtu
@@ -109,9 +111,51 @@ def run_static(scene, out: str | Path, overwrite: bool = False, progress: bool =
             profiles = fe_static_profiles(scene, model, equilibrium.q)
             write_atomic(out / "static_profiles.h5", lambda tmp: profiles.to_netcdf(tmp, engine="h5netcdf"))
             write_path_vtu(out / "static_path.vtu", profiles)
+            report["buckling"] = static_buckling(profiles, model.vertex_gap,
+                                                 lambda: unstable_modes(scene, model, equilibrium.q))
+            if report["buckling"]["unstable"]:
+                reasons = [*reasons, report["buckling"]["message"]]
+                report["suspect_reasons"] = reasons
+                summary.update(status="suspect", suspect_reasons=reasons)
         write_json(out / "static.json", report)
         summary["message"] = "static.json"
     return report
+
+
+#: A buckled span of a static state whose largest lateral displacement is below this share of the clearance lies
+#: off the wall: the straight state of a compressed string, an equilibrium that is not stable.
+OFF_THE_WALL = 0.5
+
+
+def static_buckling(profiles, gap: np.ndarray, unstable_modes) -> dict:
+    """Where the FE static state of a string in its well is compressed beyond its sinusoidal or helical buckling
+    loads in the hole (:func:`~fenics_drill.observables.buckling.buckled_spans` of its axial force), with a sentence
+    that says so.  Those loads are a long string's: where the buckled span lies off the wall (:data:`OFF_THE_WALL`),
+    ``unstable_modes()`` (the drive-held modes without stiffness about the state) says whether the straight state
+    found stands (a short span's own Euler load can carry the compression) or not (``unstable``)."""
+    md, middle = profiles["md"].values, profiles["md_element"].values
+    spans = buckled_spans(middle, np.diff(md), -profiles["axial_force"].values,
+                          profiles["sinusoidal_buckling_load"].values, profiles["helical_buckling_load"].values)
+    spans["unstable"], spans["message"] = False, None
+    if spans["first_buckled_md_m"] is None:
+        return spans
+    inside = (md >= spans["first_buckled_md_m"]) & (md <= spans["last_buckled_md_m"])
+    share = float(np.max(profiles["lateral_displacement"].values[inside] / gap[inside])) if inside.any() else 0.0
+    sinusoidal, helical = spans["buckling_loads_at_max_compression_N"]
+    modes = unstable_modes() if share < OFF_THE_WALL else []
+    spans["unstable"], spans["unstable_mode_count"] = bool(modes), len(modes)
+    spans["unstable_modes"] = modes[:REPORTED_MODES]
+    where = ("lies buckled on the wall" if share >= OFF_THE_WALL else
+             f"the state found lies off the wall there, straight, and does not stand: {len(modes)} mode(s) of the "
+             f"drive-held string have no positive stiffness about it (the first bends most at md "
+             f"{modes[0]['largest_lateral_displacement_at_m']:.0f} m)" if modes else
+             "stands straight off the wall there (stable over its length: those loads are a long string's)")
+    spans["message"] = (
+        f"the string is compressed beyond its buckling load in the hole from md {spans['first_buckled_md_m']:.0f} m to "
+        f"{spans['last_buckled_md_m']:.0f} m (helically over {spans['helically_buckled_length_m']:.0f} m, "
+        f"sinusoidally over {spans['sinusoidally_buckled_length_m']:.0f} m; up to {spans['max_compression_N'] / 1e3:.4g} "
+        f"kN against {sinusoidal / 1e3:.4g} kN sinusoidal and {helical / 1e3:.4g} kN helical there) and {where}")
+    return spans
 
 
 #: The share of the run after which the progress line gives an estimate of the time left.
@@ -262,7 +306,8 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
     if comm.size > 1:
         comm.bcast(None, root=0)
     clock = time.perf_counter()
-    summary: dict = {"command": "run", "status": "failed", "message": "", "t_end": 0.0, "steps": 0}
+    summary: dict = {"command": "run", "status": "failed", "message": "", "t_end": 0.0, "steps": 0,
+                     **scene_record(scene)}
     recorder = simulation = None
     host = socket.gethostname()
 

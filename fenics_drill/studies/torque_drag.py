@@ -21,7 +21,7 @@ from fenics_drill.model.discretization import THETA_X, THETA_Y, THETA_Z, U, V, W
 from fenics_drill.model.soft_string import operations, soft_string, stretch, string_mesh
 from fenics_drill.model.string_sections import string_sections
 from fenics_drill.model.well import dogleg_severity_deg_per_30m, well_of
-from fenics_drill.observables.buckling import helical_load, sinusoidal_load
+from fenics_drill.observables.buckling import buckled_spans, helical_load, sinusoidal_load
 from fenics_drill.observables.torque_drag import string_profiles
 from fenics_drill.scene import SceneError
 from fenics_drill.studies.lifecycle import command_output
@@ -80,15 +80,14 @@ def torque_drag_study(scene) -> dict:
         for name in ("tension", "torque", "wall_force_per_length"):
             profiles[f"{name}_{operation.name}"] = loads[name]
         profiles[f"buckling_{operation.name}"] = np.where(helical, 2, np.where(sinusoidal, 1, 0))
+        spans = buckled_spans(middle, ds, compression, f_sin, f_hel)
         results[operation.name] = {
             "hook_load_N": float(loads["tension"][0]),
             "surface_torque_Nm": float(loads["torque"][0]),
             "axial_velocity_m_s": operation.axial_velocity, "rotation_speed_rad_s": operation.rotation_speed,
             "bit_force_N": operation.bit_force, "bit_torque_Nm": operation.bit_torque,
-            "max_compression_N": float(max(compression.max(), 0.0)),
-            "sinusoidally_buckled_length_m": float(ds[sinusoidal].sum()),
-            "helically_buckled_length_m": float(ds[helical].sum()),
-            "first_buckled_md_m": float(middle[sinusoidal | helical][0]) if np.any(sinusoidal | helical) else None,
+            **{k: spans[k] for k in ("max_compression_N", "sinusoidally_buckled_length_m",
+                                     "helically_buckled_length_m", "first_buckled_md_m")},
             "max_wall_force_per_length_N_m": float(loads["wall_force_per_length"].max()),
             "stretch_m": stretch(mesh, sections, loads["tension"], -0.5 * (position[1:, 2] + position[:-1, 2]), g,
                                  outer, inner),
@@ -208,3 +207,17 @@ def write_torque_drag(scene, out: str | Path, overwrite: bool = False) -> dict:
         summary["hook_load_N"] = {k: v["hook_load_N"] for k, v in study["report"]["operations"].items()}
         summary["surface_torque_Nm"] = {k: v["surface_torque_Nm"] for k, v in study["report"]["operations"].items()}
     return study
+
+
+def buckling_on_bottom(scene, weight_on_bit: float) -> str:
+    """What the soft string says of the scene's string rotating on bottom with ``weight_on_bit`` [N]: where it is
+    buckled, a sentence (what a static solve that cannot carry that weight is told)."""
+    study = torque_drag_study(scene.with_changes(torque_drag={"operations": ["rotating_on_bottom"],
+                                                              "weight_on_bit": weight_on_bit}))
+    op = study["report"]["operations"]["rotating_on_bottom"]
+    if op["first_buckled_md_m"] is None:
+        return f"the soft string at {weight_on_bit / 1e3:.4g} kN on bottom is not buckled"
+    return (f"the soft string at {weight_on_bit / 1e3:.4g} kN on bottom is buckled from md {op['first_buckled_md_m']:.0f}"
+            f" m, helically over {op['helically_buckled_length_m']:.0f} m and sinusoidally over "
+            f"{op['sinusoidally_buckled_length_m']:.0f} m (compression up to {op['max_compression_N'] / 1e3:.4g} kN): "
+            "a string snapping into a helix in its hole, which a static solve does not follow; lower the weight on bit")

@@ -24,6 +24,9 @@ hole_cased = [true, false]
 [fluid]
 density = 1200.0
 
+[drive]
+start = "off_bottom"  # hanging: the hook holds the string's weight
+
 [[string.sections]]
 name = "collar"
 length = 20.0

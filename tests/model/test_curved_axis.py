@@ -21,9 +21,9 @@ from tests.conftest import scene_with
 
 
 def well(md, inclination, azimuth):
-    """Overrides that give the scene these survey stations."""
+    """Overrides that give the scene these survey stations, the string hanging off bottom in them."""
     return (f"well.md={list(map(float, md))}", f"well.inclination={list(map(float, inclination))}",
-            f"well.azimuth={list(map(float, azimuth))}")
+            f"well.azimuth={list(map(float, azimuth))}", "drive.start='off_bottom'")
 
 
 def test_bishop_frame_is_carried_without_twist_and_holds_the_curvature():

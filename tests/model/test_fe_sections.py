@@ -23,11 +23,11 @@ COLLAR = {"name": "collar", "length": 40.0, "outer_radius": 0.0857, "inner_radiu
 
 
 def sectioned(sections, *overrides, **tables):
-    """A scene with these string sections (from the bit up) and whole tables (``well={...}``)."""
+    """A scene with these string sections (from the bit up) and whole tables (``well={...}``), hanging off bottom."""
     from fenics_drill.scene import validate
 
     merged = load_scene(None, ["contact.friction_model='paper'", "contact.sliding_velocity_scale=1e-3",
-                               *overrides]).to_dict()
+                               "drive.start='off_bottom'", *overrides]).to_dict()
     merged["string"]["sections"] = list(sections)
     for name, table in tables.items():
         merged[name].update(table)

@@ -33,13 +33,13 @@ def toml_table(section: dict) -> str:
 
 
 def vertical_string(sections, elements, *overrides):
-    """The sections (from the bit up) hanging in a vertical hole of radius 0.108 m, in air, full order."""
+    """The sections (from the bit up) hanging off bottom in a vertical hole of radius 0.108 m, in air, full order."""
     length = sum(s["length"] for s in sections)
     return scene_with(f"string.sections=[{', '.join(toml_table(s) for s in sections)}]",
                       f"well.md=[0.0, {length}]", "well.inclination=[0.0, 0.0]", "well.azimuth=[0.0, 0.0]",
                       f"well.hole_bottom=[{length}]", "well.hole_radius=[0.108]", "well.hole_cased=[false]",
                       f"beam.elements={elements}", f"beam.young_modulus={E}", f"beam.poisson_ratio={NU}",
-                      f"beam.density={RHO}", "reduction.rule='none'", *overrides)
+                      f"beam.density={RHO}", "reduction.rule='none'", "drive.start='off_bottom'", *overrides)
 
 
 def segments(sections, kind):
@@ -202,3 +202,36 @@ def test_the_reduced_basis_in_a_well_is_chosen_from_the_prestressed_modes():
     report = modal_report(scene)
     kept = [report["modes"][i]["frequency_hz"] for i in report["reduced_basis"]["mode_indices"]]
     np.testing.assert_allclose(sorted(kept), np.sort(model.basis.frequencies_hz), rtol=1e-9)
+
+
+def test_modal_above_the_first_buckling_load_reports_buckling_not_a_critical_speed_of_zero(tmp_path, capsys):
+    """A weightless 50 m pipe in a vertical hole, held at the top (clamped laterally by the drive) and pinned at the
+    bit, pressed at the bit: Euler's fixed-pinned column buckles at P = (kL)^2 E I / L^2, tan kL = kL (kL = 4.4934).
+    At 0.99 P the drive-held string still has a positive lowest lateral frequency; at 1.01 P the modal analysis says
+    it is buckled, which mode and where it bends most (the fixed-pinned shape sin kx - kL cos kx - kx + kL peaks
+    where cos kx + kL sin kx = 1), and gives no critical speed.  The 1 % margin is far above the discretisation's
+    error (40 quadratic elements: the first lateral mode of the unloaded pipe within 1e-6 of the beam's)."""
+    from fenics_drill.cli import main
+    from fenics_drill.scene import load_scene
+
+    brentq = scipy.optimize.brentq
+    E_, R, r, L = 203e9, 0.08, 0.05, 50.0
+    kL = brentq(lambda z: math.tan(z) - z, 4.4, 4.5)
+    critical = kL**2 * E_ * math.pi / 4 * (R**4 - r**4) / L**2
+    peak = brentq(lambda x: math.cos(kL * x) + kL * math.sin(kL * x) - 1.0, 0.3, 0.9) * L
+    base = [f"beam.length={L}", "beam.elements=40", f"beam.outer_radius={R}", f"beam.inner_radius={r}",
+            f"beam.young_modulus={E_}", "well.md=[0.0, 50.0]", "well.inclination=[0.0, 0.0]",
+            "well.azimuth=[0.0, 0.0]", "model.gravity=false", "modal.state='static'", "reduction.rule='none'"]
+    below = modal_report(load_scene(None, [*base, f"modal.weight_on_bit={0.99 * critical}"]))
+    assert below["buckled"] is None and all(f > 0 for f in below["lateral_critical_speeds_rpm"])
+    above = modal_report(load_scene(None, [*base, f"modal.weight_on_bit={1.01 * critical}"]))
+    buckled = above["buckled"]
+    assert buckled is not None and above["lateral_critical_speeds_rpm"] == []
+    first = buckled["modes"][0]
+    assert first["kind"] == "flexural" and first["omega_squared"] < 0
+    assert abs(first["largest_lateral_displacement_at_m"] - peak) <= L / 40  # within one element
+    assert buckled["weight_on_bit_N"] == pytest.approx(1.01 * critical, rel=1e-12)
+    overrides = [arg for key in [*base, f"modal.weight_on_bit={1.01 * critical}"] for arg in ("--set", key)]
+    assert main(["modal", *overrides, "--out", str(tmp_path / "modal")]) == 0
+    out = capsys.readouterr().out
+    assert "BUCKLED: the string is buckled at" in out and "critical speeds" not in out

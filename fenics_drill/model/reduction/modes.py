@@ -46,15 +46,21 @@ class ModalBasis:
     kinds: list[str]
     energy_fractions: np.ndarray  # (n_modes, 6): kinetic energy share of u, v, w, tx, ty, tz
     vectors: np.ndarray | None  # (ndofs, n_modes); None: not kept (frequencies and kinds only)
+    #: omega^2 of each mode, signed [1/s^2] (the frequencies clip a negative one to 0: a buckled mode); None: not known
+    eigenvalues: np.ndarray | None = None
+    #: x of each mode's largest lateral displacement [m] (None: not known)
+    lateral_peak_x: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.frequencies_hz)
 
     def select(self, indices) -> "ModalBasis":
         idx = np.asarray(indices, dtype=int)
+        pick = lambda a: None if a is None else a[idx]  # noqa: E731
         return ModalBasis(
             self.frequencies_hz[idx], self.f_star[idx], [self.kinds[i] for i in idx],
             self.energy_fractions[idx], None if self.vectors is None else self.vectors[:, idx],
+            pick(self.eigenvalues), pick(self.lateral_peak_x),
         )
 
 
@@ -194,7 +200,8 @@ def solve_modes(disc: BeamDiscretization, f_star_max: float, mass=None, held: tu
     constrained = np.zeros(disc.ndofs, dtype=bool)
     constrained[np.asarray(disc.support_dofs, dtype=int)] = True
     constrained[[disc.end_dof(field, end) for field, end in held]] = True
-    eigenvalues, fractions, groups = [], [], []
+    eigenvalues, fractions, groups, peaks = [], [], [], []
+    lateral = np.isin(disc.field_of_dof, (V, W))
     for fields in coupled_field_groups((K, M), disc.field_of_dof):  # (62) one coupled group at a time
         dofs = np.flatnonzero(np.isin(disc.field_of_dof, fields)).astype(np.int32)
         free = int(np.count_nonzero(~constrained[dofs]))
@@ -209,6 +216,9 @@ def solve_modes(disc: BeamDiscretization, f_star_max: float, mass=None, held: tu
         block /= np.sqrt(np.einsum("ij,ij->j", block, group_mass @ block))
         eigenvalues.append(values)
         fractions.append(field_mass_fractions(group_mass, disc.field_of_dof[dofs], block))
+        sideways = lateral[dofs]
+        peaks.append(disc.dof_coordinates[dofs[sideways]][np.argmax(np.abs(block[sideways]), axis=0)]
+                     if sideways.any() else np.full(block.shape[1], np.nan))
         groups.append((dofs, block if vectors else None))
     for obj in (K, M):
         obj.destroy()
@@ -226,7 +236,7 @@ def solve_modes(disc: BeamDiscretization, f_star_max: float, mass=None, held: tu
             stacked[dofs[:, None], np.arange(column, column + block.shape[1])] = block
             column += block.shape[1]
         stacked = stacked[:, order]
-    return ModalBasis(freqs, f_star, kinds, fractions, stacked)
+    return ModalBasis(freqs, f_star, kinds, fractions, stacked, eigenvalues, np.concatenate(peaks)[order])
 
 
 def paper_bands(length: float, longitudinal_wave_speed: float) -> dict[str, float]:
