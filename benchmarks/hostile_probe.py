@@ -6,10 +6,12 @@ tool (or a Python snippet) in its own process under a timeout.  Every case ends 
 * ``suspect``: it finished and said why its answer is doubtful (summary "suspect");
 * ``failed (stated)``: it ended "failed" with its reason in one line;
 * ``bad input accepted``: an input the case marks inadmissible ran without a word;
+* ``silent answer``: it finished, but what it printed or wrote is not what the input means (a value misread, a
+  buckled string given a critical speed, a note missing): the case's ``check`` says what is wrong;
 * ``unclear``: refused, but in more than one line;
 * ``traceback``, ``hang`` (past the timeout), ``data loss`` (a user's file gone or changed).
 
-    python benchmarks/hostile_probe.py [--table benchmarks/results/hostile_probe.md] [--workers 2]
+    python benchmarks/hostile_probe.py [--table benchmarks/results/hostile_probe.md] [--workers 2] [--match TEXT]
 
 The counts go to the table's head, every case below it (docs/reliability.md).
 """
@@ -37,8 +39,8 @@ PAPER = str(ROOT / "demos" / "scenes" / "paper.toml")
 #: A case still running after this long is a hang.
 TIMEOUT = 120
 SMALL = ["--set", "beam.length=20", "--set", "beam.elements=40"]
-CLASSES = ("refused", "correct", "suspect", "failed (stated)", "bad input accepted", "unclear", "traceback", "hang",
-           "data loss")
+CLASSES = ("refused", "correct", "suspect", "failed (stated)", "bad input accepted", "silent answer", "unclear",
+           "traceback", "hang", "data loss")
 
 # the 120 m string of collar and drill pipe in mud that the hostile-input tests use
 sys.path.insert(0, str(ROOT / "tests" / "cli"))
@@ -51,7 +53,8 @@ SURVEY = "md,inclination,azimuth\n0,0,0\n40,0,0\n120,45,30\n"
 class Case:
     """One hostile input: ``argv`` for the tool (``mpi`` ranks under mpiexec), or a Python ``snippet``; the files
     ``setup(workdir)`` lays out first; ``admissible`` whether the input should run; ``keep`` the user's files that
-    must survive (name -> content)."""
+    must survive (name -> content); ``check(stdout, workdir)`` what is wrong with a finished case's answer (None:
+    nothing); ``cwd`` the working directory (WORK/... or the repository)."""
 
     name: str
     argv: list = field(default_factory=list)
@@ -60,6 +63,8 @@ class Case:
     admissible: bool = False
     keep: dict = field(default_factory=dict)
     mpi: int = 0
+    check: object = None
+    cwd: str = ""
 
 
 def well_files(workdir: Path, survey: str | bytes | None = SURVEY, collar: str = "", extra: str = "") -> Path:
@@ -306,22 +311,152 @@ def compute_cases() -> list[Case]:
     ]
 
 
+def printed_value(stdout: str, section: str, key: str) -> float | None:
+    """The value ``fenics-drill scene`` printed for ``section.key`` (None where it printed none)."""
+    current = None
+    for line in stdout.splitlines():
+        if line.startswith("[") and line.endswith("]"):
+            current = line[1:-1]
+        elif current == section and line.startswith(f"{key} = "):
+            return json.loads(line.split(" = ", 1)[1].split("  #", 1)[0])
+    return None
+
+
+def reads_as(dotted: str, expected: float):
+    """A check that ``scene`` printed ``expected`` [SI] for ``dotted`` (a list: its first entry), to round-off."""
+    section, key = dotted.split(".")
+
+    def check(stdout, work):
+        value = printed_value(stdout, section, key)
+        value = value[0] if isinstance(value, list) else value
+        if value is None or abs(value - expected) > 1e-12 * max(abs(expected), 1.0):
+            return f"{dotted} read as {value!r}, which is not {expected!r}"
+        return None
+
+    return check
+
+
+#: Drilling spellings (key, as written, its SI value by the definitions of NIST SP 811).
+SPELLINGS = [
+    ("beam.outer_radius", '"3 1/4 in"', 3.25 * 0.0254), ("beam.outer_radius", '"3-1/4 in"', 3.25 * 0.0254),
+    ("beam.outer_radius", '"3\u00bc in"', 3.25 * 0.0254), ("beam.outer_radius", "'3 1/4\"'", 3.25 * 0.0254),
+    ("beam.outer_radius", "'3.25\"'", 3.25 * 0.0254), ("beam.outer_radius", "\"3.25''\"", 3.25 * 0.0254),
+    ("beam.outer_radius", '"3 IN"', 3 * 0.0254), ("well.hole_radius", '["4 13/16 in"]', 4.8125 * 0.0254),
+    ("torque_drag.torque_on_bit", '"5 000 N m"', 5000.0), ("torque_drag.torque_on_bit", '"5 kN.m"', 5000.0),
+    ("torque_drag.torque_on_bit", '"5 kft-lbf"', 5000 * 0.3048 * 4.4482216152605),
+    ("torque_drag.torque_on_bit", '"3700 ft-lbf"', 3700 * 0.3048 * 4.4482216152605),
+    ("torque_drag.torque_on_bit", '"5000 Nm"', 5000.0), ("fluid.density", '"1 200 kg/m^3"', 1200.0),
+    ("fluid.density", '"78 pcf"', 78 * 0.45359237 / 0.3048**3), ("fluid.density", '"1.25 g/cm3"', 1250.0),
+    ("contact.friction", "0,3", 0.3), ("drive.weight_on_bit", '"40 000 N"', 40e3),
+    ("drive.weight_on_bit", '"5 klb"', 5e3 * 4.4482216152605), ("drive.weight_on_bit", '"2 tf"', 2000 * 9.80665),
+    ("drive.rotation_speed", '"120 1/min"', 4 * 3.141592653589793),
+    ("drive.rotation_speed", '"120 min^-1"', 4 * 3.141592653589793),
+    ("drive.rotation_speed", '"2 Hz"', 4 * 3.141592653589793), ("drive.rotation_speed", '"120 RPM"', 4 * 3.141592653589793),
+    ("drive.rotation_speed", '"120 rev/min"', 4 * 3.141592653589793),
+    ("drive.rotation_speed", '"120 r/min"', 4 * 3.141592653589793),
+    ("drive.axial_velocity", '"50 fph"', 50 * 0.3048 / 3600), ("drive.rotation_speed", '"\u221260 rpm"', -2 * 3.141592653589793),
+]
+
+
+def unit_cases() -> list[Case]:
+    """Drilling spellings read to their SI values (a misread is a silent answer); ambiguous spellings refused."""
+    cases = [Case(f"units: {dotted} = {written}", ["scene", "--set", f"{dotted}={written}"], admissible=True,
+                  check=reads_as(dotted, si)) for dotted, written, si in SPELLINGS]
+    for dotted, written in (("contact.friction", '"1,200"'), ("drive.weight_on_bit", '"4 tonf"'),
+                            ("contact.friction", '"17 deg"'), ("drive.weight_on_bit", '"5 00 N"'),
+                            ("beam.outer_radius", '"4 5/4 in"'), ("fluid.density", '"1,200 kg/m^3"'),
+                            ("drive.weight_on_bit", '"2 ton"')):
+        cases.append(Case(f"units: {dotted} = {written} (ambiguous)", ["scene", "--set", f"{dotted}={written}"]))
+    return cases
+
+
+def says(*words):
+    """A check that the finished case's output holds ``words`` (its report of the input's meaning)."""
+    def check(stdout, work):
+        missing = [w for w in words if w not in stdout]
+        return f"it did not say {missing[0]!r}" if missing else None
+
+    return check
+
+
+def well_reading_cases() -> list[Case]:
+    """A well as a new user describes it: a survey beside the scene read from elsewhere, feet and their round-off,
+    vendors' azimuth columns, a bit smaller than its BHA, a string shorter than its well, weights that the string
+    cannot give or carry, a user's file saved while a command runs."""
+    vertical = "md,inclination,azimuth\n0,0,0\n120,0,0\n"
+
+    def elsewhere(w):
+        well_files(w, vertical)
+        (w / "elsewhere").mkdir()
+        (w / "elsewhere" / "survey.csv").write_text(SURVEY)
+
+    def tvd_is(expected):
+        def check(stdout, work):
+            tvd = json.loads((work / "o" / "torque_drag.json").read_text())["well"]["true_vertical_depth_m"]
+            return None if abs(tvd - expected) < 1e-6 else f"TVD {tvd:.6g} m, the well's is {expected:g} m"
+        return check
+
+    feet = "MD (ft),Inc (deg),Azi (deg)\n0,0,0\n131.23,0,0\n393.70,45,30\n"  # 120.0006 m
+    both = "MD (m),Inc (deg),Azi (grid),Azim True (deg)\n0,0,0,0\n40,0,0,0\n120,45,32,30\n"
+    grid = "MD (m),Inc (deg),Azi (grid)\n0,0,0\n40,0,0\n120,45,32\n"
+    users_file = ("import pathlib, sys\nimport fenics_drill.studies.run as run\nfrom fenics_drill.cli import main\n"
+                  "out = pathlib.Path('WORK/o')\nprepare = run.prepare\n"
+                  "def meanwhile(*a, **k):\n    (out / 'field_notes.txt').write_text('notes')\n"
+                  "    return prepare(*a, **k)\nrun.prepare = meanwhile\n"
+                  f"small = {SMALL!r}\nassert main(['static', {PAPER!r}, *small, '--out', str(out)]) == 0\n"
+                  "run.prepare = prepare\n"
+                  f"sys.exit(main(['static', {PAPER!r}, *small, '--overwrite', '--out', str(out)]))\n")
+    bha = ('\n[bit_rock]\nlaw = "detournay"\nbit_radius = "1 1/2 in"\n')
+    hook = '\n[drive]\nmode = "hook_load"\n[bit_rock]\nlaw = "detournay"\nbit_radius = 0.09\n'
+    return [
+        Case("well: a survey beside the scene, read from another folder", ["torque-drag", "../well.toml", "--out",
+             "WORK/o"], setup=elsewhere, cwd="WORK/elsewhere", admissible=True, check=tvd_is(120.0)),
+        Case("well: a survey in feet ending 0.6 mm past the string", ["scene", "WORK/well.toml"],
+             setup=lambda w: well_files(w, feet), admissible=True),
+        Case("well: a grid azimuth beside the true one", ["scene", "WORK/well.toml"], setup=lambda w: well_files(w, both),
+             admissible=True, check=says("'Azim True (deg)' read as the azimuth")),
+        Case("well: a grid azimuth alone", ["scene", "WORK/well.toml"], setup=lambda w: well_files(w, grid)),
+        Case("well: a bit smaller than its collars", ["scene", "WORK/well.toml"],
+             setup=lambda w: well_files(w, extra=bha)),
+        Case("well: a string 20 m shorter than its well", ["torque-drag", "WORK/well.toml", "--out", "WORK/o"],
+             setup=lambda w: well_files(w, "md,inclination,azimuth\n0,0,0\n40,0,0\n140,45,30\n"), admissible=True,
+             check=says("the bit is 20 m above the well's bottom")),
+        Case("well: 1e6 kN on the bit of a hook-load drive, seen by `scene`", ["scene", "WORK/well.toml", "--set",
+             'drive.weight_on_bit="1e6 kN"'], setup=lambda w: well_files(w, extra=hook)),
+        Case("well: modal.weight_on_bit above the string's weight, hook-load drive", ["modal", "WORK/well.toml", "--set",
+             'modal.weight_on_bit="1e3 kN"', "--out", "WORK/o"], setup=lambda w: well_files(w, extra=hook)),
+        Case("well: a velocity drive in a well starts on bottom", ["static", "WORK/well.toml", "--out", "WORK/o"],
+             setup=lambda w: well_files(w), admissible=True, check=says("the bit pressed at 25 kN")),
+        Case("modal: a weightless 50 m pipe pressed beyond its Euler load", ["modal", "--set", "beam.length=50.0",
+             "--set", "beam.elements=40", "--set", "well.md=[0.0, 50.0]", "--set", "well.inclination=[0.0, 0.0]",
+             "--set", "well.azimuth=[0.0, 0.0]", "--set", "model.gravity=false", "--set", "modal.state='static'",
+             "--set", "modal.weight_on_bit=60e3", "--set", "reduction.rule='none'", "--out", "WORK/o"],
+             admissible=True, check=says("BUCKLED: the string is buckled at 60 kN")),
+        Case("static: a weightless 2000 m string pressed at 168.48 kN", ["static", "--set", "beam.length=2000.0",
+             "--set", "beam.elements=100", "--set", "well.md=[0.0, 2000.0]", "--set", "well.inclination=[0.0, 0.0]",
+             "--set", "well.azimuth=[0.0, 0.0]", "--set", "model.gravity=false", "--set", "drive.weight_on_bit=168.48e3",
+             "--set", "reduction.rule='none'", "--out", "WORK/o"], admissible=True,
+             check=says("the top pushes with 168.48 kN", "does not stand")),
+        Case("output: a user's file saved while `static` runs, then --overwrite", snippet=users_file,
+             keep={"o/field_notes.txt": "notes"}),
+    ]
+
+
 def run_case(case: Case, root: Path) -> dict:
     """Lay out the case's files in a fresh folder, run it, and classify what happened."""
     work = root / f"case{abs(hash(case.name)) % 10**10}"
     work.mkdir()
     if case.setup is not None:
         case.setup(work)
-    kept = {name: (work / name).read_text() for name in case.keep if (work / name).exists()}
     clock = time.perf_counter()
     if case.snippet:
-        command = [PYTHON, "-c", case.snippet]
+        command = [PYTHON, "-c", case.snippet.replace("WORK", str(work))]
     else:
         argv = [a.replace("WORK", str(work)) for a in case.argv]
         command = ([MPIEXEC, "-n", str(case.mpi)] if case.mpi else []) + [*TOOL, *argv]
     try:
-        result = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT, cwd=ROOT,
-                                stdin=subprocess.DEVNULL)
+        result = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT,
+                                cwd=case.cwd.replace("WORK", str(work)) if case.cwd else ROOT, stdin=subprocess.DEVNULL)
     except subprocess.TimeoutExpired:
         return {"name": case.name, "class": "hang", "message": f"still running after {TIMEOUT} s",
                 "seconds": TIMEOUT}
@@ -329,7 +464,7 @@ def run_case(case: Case, root: Path) -> dict:
     err = result.stderr.strip()
     lines = [line for line in err.splitlines() if line.strip() and not line.startswith("  ")
              and "runs on one process" not in line]
-    lost = [name for name, text in kept.items() if not (work / name).exists() or (work / name).read_text() != text]
+    lost = [name for name, text in case.keep.items() if not (work / name).exists() or (work / name).read_text() != text]
     status = None
     summary = work / "o" / "summary.json"
     if summary.exists():
@@ -347,6 +482,9 @@ def run_case(case: Case, root: Path) -> dict:
         kind = ("suspect" if status == "suspect" else "correct") if case.admissible else "bad input accepted"
         if not case.admissible and status == "suspect":
             kind = "suspect"
+        wrong = case.check(result.stdout, work) if case.check is not None else None
+        if wrong:
+            kind, lines = "silent answer", [wrong]
     elif status == "failed" and len(lines) <= 2:
         kind = "failed (stated)"
     else:
@@ -359,9 +497,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--table", type=Path, default=ROOT / "benchmarks" / "results" / "hostile_probe.md")
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--match", default="", help="run only the cases whose name holds this text (a table of them)")
     args = parser.parse_args()
     cases = [*key_cases(), *survey_cases(), *section_cases(), *output_cases(), *api_cases(), *mpi_cases(),
-             *compute_cases()]
+             *compute_cases(), *unit_cases(), *well_reading_cases()]
+    cases = [case for case in cases if args.match in case.name]
     root = Path(tempfile.mkdtemp(prefix="fenics-drill-probe-"))
     clock = time.perf_counter()
     try:
@@ -383,7 +523,8 @@ def main() -> None:
         lines.append(f"| {r['name'].replace('|', chr(92) + '|')} | {r['class']} | {said} | {r['seconds']} |")
     args.table.write_text("\n".join(lines) + "\n")
     print("\n".join(lines[:8]))
-    bad = [r for r in results if r["class"] in ("traceback", "hang", "data loss", "unclear", "bad input accepted")]
+    bad = [r for r in results if r["class"] in ("traceback", "hang", "data loss", "unclear", "bad input accepted",
+                                                "silent answer")]
     for r in bad:
         print(f"  {r['class']}: {r['name']}: {r['message']}")
 

@@ -38,6 +38,7 @@ except KeyboardInterrupt:
     raise
 
 from fenics_drill.scene import Scene, SceneError, load_scene  # noqa: E402
+from fenics_drill.units import UnitError, read_quantity  # noqa: E402  (a drilling value in SI: "8 1/2 in" -> m)
 
 __version__ = "0.2.0"
 
@@ -45,7 +46,7 @@ __version__ = "0.2.0"
 _API = ("RunResult", "modal_analysis", "static_state", "run", "monte_carlo", "operating_window", "campbell", "TorqueDragResult",
         "torque_drag", "plot")
 
-__all__ = ["Scene", "SceneError", "load_scene", *_API]
+__all__ = ["Scene", "SceneError", "load_scene", "UnitError", "read_quantity", *_API]
 
 
 def __getattr__(name: str):

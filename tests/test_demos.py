@@ -18,3 +18,41 @@ def test_modal_distributions_regenerate_table_4(tmp_path):
     assert table.strip() in (ROOT / "docs" / "table4.md").read_text()
     for name in ("fig10_flexural_modes.png", "fig11_torsional_modes.png", "fig12_axial_modes.png"):
         assert (tmp_path / name).stat().st_size > 10_000
+
+
+DEMO_SCENES = sorted((ROOT / "demos" / "scenes").glob("*.toml"))
+#: The demo scenes that are not for `static` and `run` (their comments say which command they are for).
+CAMPBELL_ONLY = ("campbell_paper.toml",)
+
+
+def test_every_demo_scene_passes_the_checks_of_its_mesh_and_step():
+    """The mesh and step checks ``static`` and ``run`` apply to a user's scene (8 nodes per flexural wavelength at the
+    band's top, the step against f_max) pass on every demo scene as it is shipped."""
+    from fenics_drill.scene import load_scene
+    from fenics_drill.studies.run import discretisation_reasons
+
+    failing = {f"{scene.name} ({command})": reasons for scene in DEMO_SCENES if scene.name not in CAMPBELL_ONLY
+               for command in ("static", "run")
+               if (reasons := discretisation_reasons(load_scene(scene), {"command": command}))}
+    assert not failing, failing
+
+
+def test_the_demo_wells_static_and_run_end_finished(tmp_path):
+    """``static`` and a 2 ms ``run`` of the VBH demo well (on bottom, its velocity drive pressing the bit at 25 kN) and
+    of the paper's scene end ``finished``, with no suspect reason.  2 ms: what the checks judge is the scene's
+    discretisation and its start, not the run's length."""
+    import json
+
+    failures = []
+    for scene in ("well_vbh.toml", "paper.toml"):
+        for command, extra in (("static", []), ("run", ["--set", "time.t_end=0.002", "--set", "output.field_interval=0",
+                                                        "--quiet"])):
+            out = tmp_path / f"{scene}-{command}"
+            done = subprocess.run([sys.executable, "-m", "fenics_drill.cli", command,
+                                   str(ROOT / "demos" / "scenes" / scene), *extra, "--out", str(out)],
+                                  capture_output=True, text=True, timeout=600)
+            summary = json.loads((out / "summary.json").read_text()) if (out / "summary.json").exists() else {}
+            if done.returncode != 0 or summary.get("status") != "finished":
+                failures.append(f"{command} {scene}: {summary.get('status')} "
+                                f"{summary.get('suspect_reasons') or summary.get('message') or done.stderr[-300:]}")
+    assert not failures, "\n".join(failures)
