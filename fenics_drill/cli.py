@@ -16,13 +16,15 @@ import os
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from fenics_drill import __version__
 from fenics_drill.scene import SceneError, load_scene, section_keys, unused_keys
 
 #: Commands run in a supervised worker process (single-process commands that can run long).
 SUPERVISED = ("run", "static", "modal", "campbell")
 #: Commands that run on one process: under ``mpiexec -n N`` the first rank runs them and the others end at once.
-SINGLE_PROCESS = ("scene", "modal", "static", "campbell", "plot", "forms", "torque-drag")
+SINGLE_PROCESS = ("scene", "modal", "static", "campbell", "plot", "forms", "torque-drag", "broomstick", "calibrate")
 
 
 
@@ -260,11 +262,14 @@ def cmd_forms(args) -> int:
 
 
 def cmd_torque_drag(args) -> int:
-    """Soft-string torque and drag along the scene's well: DIR/torque_drag.json, torque_drag.h5, well.vtu, figures."""
+    """Soft-string torque and drag along the scene's well: DIR/torque_drag.json, torque_drag.h5, well.vtu, figures;
+    with --samples N, under uncertainty over MPI ranks: DIR/risk.json, risk.nc, risk.png."""
     from fenics_drill.plots.directory import plot_directory
     from fenics_drill.studies.torque_drag import write_torque_drag
 
     scene = load_scene(args.scene, args.overrides)
+    if args.samples is not None:
+        return _risk(scene, args)
     report = write_torque_drag(scene, args.out, overwrite=args.overwrite)["report"]
     _drawn(lambda: plot_directory(Path(args.out)))
     well = report["well"]
@@ -278,6 +283,81 @@ def cmd_torque_drag(args) -> int:
         locked = ", LOCKED UP: the surface would have to push" if op["locked_up"] else ""
         print(f"  {name:<20s} hook load {op['hook_load_N'] / 1e3:9.1f} kN, surface torque "
               f"{op['surface_torque_Nm'] / 1e3:7.2f} kN m{buckled}{locked}")
+    return 0
+
+
+def _risk(scene, args) -> int:
+    """``torque-drag --samples N``: the study over the ranks, then (first rank) its figure and its summary."""
+    from mpi4py import MPI
+
+    from fenics_drill.plots.directory import plot_directory
+    from fenics_drill.studies.risk import write_risk
+
+    study = write_risk(scene, args.samples, args.out, resume=args.resume, overwrite=args.overwrite,
+                       progress=not args.quiet)
+    if MPI.COMM_WORLD.rank > 0 or study is None:
+        return 0
+    _drawn(lambda: plot_directory(Path(args.out)))
+    report = study["report"]
+    print(f"{report['samples']} realisations on {report['ranks']} rank(s), {report['depths']} bit depths "
+          f"[{report['wall_time_s']:.1f} s] -> {Path(args.out) / 'risk.json'}")
+    for key, what in (("max_probability_over_hook_load_limit", "the hook-load limit"),
+                      ("max_probability_over_torque_limit", "the torque limit")):
+        if report[key] is not None:
+            print(f"  probability of exceeding {what}: up to {report[key]:.3f}")
+    print(f"  probability of helical buckling slacking off at the bottom: "
+          f"{report['probability_helical_slack_off_at_bottom']:.3f}")
+    lock = report["lock_up_depth_sliding_m"]
+    print(f"  sliding reaches the bottom in {report['probability_sliding_to_bottom']:.1%} of the realisations"
+          + (f"; lock-up depth P10/P50/P90 {lock['p10']:.0f} / {lock['p50']:.0f} / {lock['p90']:.0f} m" if lock
+             else ""))
+    return 0
+
+
+def cmd_broomstick(args) -> int:
+    """The broomstick chart of the scene's well: DIR/broomstick.nc, broomstick.csv, broomstick.json, broomstick.png."""
+    from fenics_drill.plots.directory import plot_directory
+    from fenics_drill.studies.broomstick import write_broomstick
+
+    scene = load_scene(args.scene, args.overrides)
+    report = write_broomstick(scene, args.out, overwrite=args.overwrite)["report"]
+    _drawn(lambda: plot_directory(Path(args.out)))
+    pairs = report["friction_pairs"]
+    print(f"{report['depths']} bit depths to {report['well_depth_m']:.0f} m every {report['depth_step_m']:g} m, "
+          f"{len(report['operations'])} operations, {len(pairs)} friction pairs [{report['wall_time_s']:.2f} s] -> "
+          f"{Path(args.out) / 'broomstick.png'}")
+    for name, at in report["at_bottom"].items():
+        loads = np.array(at["hook_load_N"]) / 1e3
+        torques = np.array(at["surface_torque_Nm"]) / 1e3
+        print(f"  at the bottom, {name:<20s} hook load {loads.min():8.1f} to {loads.max():8.1f} kN, torque "
+              f"{torques.min():6.2f} to {torques.max():6.2f} kN m")
+    return 0
+
+
+def cmd_calibrate(args) -> int:
+    """Friction factors fitted to a measured file: DIR/calibration.json, calibration.png, friction_track.png."""
+    from fenics_drill.plots.directory import plot_directory
+    from fenics_drill.studies.calibration import write_calibration
+
+    scene = load_scene(args.scene, args.overrides)
+    report = write_calibration(scene, args.measured, args.out, overwrite=args.overwrite,
+                               fit_block=args.fit_block_weight)
+    _drawn(lambda: plot_directory(Path(args.out)))
+    print(f"{report['points']} measured points ({report['points_in_casing']} with the bit in casing, shoe at "
+          f"{report['casing_shoe_m']:.0f} m) [{report['wall_time_s']:.2f} s] -> {Path(args.out) / 'calibration.json'}")
+    for name in ("friction_cased", "friction_open"):
+        entry = report[name]
+        if entry["value"] is None:
+            print(f"  {name}: {entry['message']}")
+        else:
+            interval = entry["interval"]
+            shown = f"[{interval[0]:.4f}, {interval[1]:.4f}]" if interval else f"({entry['message']})"
+            print(f"  {name}: {entry['value']:.4f} {shown} (95 %)")
+    block = report["block_weight_N"]
+    if block["fitted"]:
+        print(f"  block weight: {block['value'] / 1e3:.1f} kN")
+    for warning in report["warnings"]:
+        print(f"warning: {warning}")
     return 0
 
 
@@ -321,7 +401,27 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("torque-drag", help="soft-string torque and drag along the scene's well (survey, string "
                                            "sections, mud): DIR/torque_drag.json, torque_drag.h5, well.vtu")
     _scene_args(p)
+    p.add_argument("--samples", type=int, default=None,
+                   help="under uncertainty: N realisations of the [risk] laws (MPI-parallel, resumable)")
+    p.add_argument("--resume", action="store_true", help="with --samples: continue the study in --out")
+    p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_torque_drag)
+    p = sub.add_parser("broomstick", help="hook load and surface torque against bit depth for the chart's operations "
+                                          "and friction factors, with the rig's limits: DIR/broomstick.nc, .csv, .png")
+    _scene_args(p)
+    p.set_defaults(func=cmd_broomstick)
+    p = sub.add_parser("calibrate", help="cased and open-hole friction factors fitted to the rig's measured hook "
+                                         "loads and torques: DIR/calibration.json, calibration.png")
+    p.add_argument("scene", help="TOML scene file of the well")
+    p.add_argument("measured", help="CSV of bit_depth and any of pick_up, slack_off, rotating_off_bottom, "
+                                    "torque_off_bottom, torque_on_bottom, units in brackets in the header")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                   help="override one scene key; the value is read as TOML (repeatable)")
+    p.add_argument("--out", default="out", help="output directory")
+    p.add_argument("--overwrite", action="store_true", help="replace this command's earlier output in --out")
+    p.add_argument("--fit-block-weight", action="store_true",
+                   help="fit the travelling equipment's weight too (else broomstick.block_weight)")
+    p.set_defaults(func=cmd_calibrate)
     p = sub.add_parser("plot", help="figures of a run (Figs. 13-23, spectra.json, animation.gif), a Monte Carlo "
                                     "study (Figs. 28-35), an operating window or a Campbell diagram")
     p.add_argument("run_dir", help="the --out directory of 'fenics-drill run', 'mc', 'optimize' or 'campbell'")
@@ -479,7 +579,7 @@ def _main(argv: list[str] | None) -> int:
         _say("fenics-drill: --out '' names no directory (it would write into the current one): give one, e.g. "
              "--out out/run1")
         return 2
-    if args.command in SINGLE_PROCESS and _under_mpiexec():
+    if args.command in SINGLE_PROCESS and _under_mpiexec() and getattr(args, "samples", None) is None:
         from mpi4py import MPI
 
         if MPI.COMM_WORLD.size > 1:

@@ -328,8 +328,7 @@ class Well:
     """The well from its survey (minimum curvature) and its hole sections; absent, the straight horizontal hole
     of ``beam.length`` and ``borehole.radius``."""
 
-    survey: str = key("", "survey CSV file (columns md, inclination, azimuth), relative to the scene file (given with "
-                      "--set: to the working directory)")
+    survey: str = key("", "survey CSV file, relative to the scene file (given with --set: to the working directory)")
     md: tuple = key((), "measured depths of the survey stations, inline instead of a file [m]", _numbers,
                     "a list of numbers")
     inclination: tuple = key((), "inclination of each station from the vertical [deg]", _numbers, "a list of numbers")
@@ -478,6 +477,76 @@ class TorqueDrag:
     element_length: float = _pos("length of the soft string's elements [m]", 10.0)
 
 
+def _friction_factors(x) -> bool:
+    return len(x) >= 1 and _positions(x) and all(0 <= v <= 1 for v in x)
+
+
+def _friction_pairs(x) -> bool:
+    return all(isinstance(p, (list, tuple)) and len(p) == 2 and _friction_factors(p) for p in x)
+
+
+#: The operations of a broomstick chart: the soft string's, named as the rig reads them.
+_CHART_OPERATIONS = ("tripping_in", "tripping_out", "rotating_off_bottom", "rotating_on_bottom", "sliding")
+
+
+@dataclass(frozen=True)
+class Broomstick:
+    """Hook load and surface torque against bit depth (``fenics-drill broomstick``), and the rig that reads them."""
+
+    depth_step: float = key(28.5, "bit depths every this many metres, a stand of three joints [m]",
+                            lambda x: x > 0, "> 0")
+    operations: tuple = key(_CHART_OPERATIONS, "operations drawn", lambda x: len(x) >= 1 and all(
+        o in _CHART_OPERATIONS for o in x), "a non-empty list of " + ", ".join(_CHART_OPERATIONS))
+    friction_cased: tuple = key((0.15, 0.2, 0.25, 0.3), "friction factors in cased hole [-]", _friction_factors,
+                                "a non-empty list of numbers in [0, 1]")
+    friction_open: tuple = key((0.2, 0.25, 0.3, 0.35), "friction factors in open hole [-]", _friction_factors,
+                               "a non-empty list of numbers in [0, 1]")
+    friction_pairs: tuple = key((), "(cased, open) pairs instead of every cased factor with every open one [-]",
+                                _friction_pairs, "a list of [cased, open] pairs of numbers in [0, 1]")
+    block_weight: float = _nonneg("weight of the travelling equipment, added to every hook load [N]", 0.0)
+    lines: int = key(0, "lines strung between crown and block; 0: the weight indicator reads the hook load [-]",
+                     lambda n: 0 <= n <= 24, "an integer in [0, 24]")
+    sheave_efficiency: float = key(1.0, "efficiency of each sheave (with lines > 0) [-]", lambda x: 0.5 <= x <= 1.0,
+                                   "in [0.5, 1]")
+    hook_load_limit: float = key(-1.0, "the rig's hook-load limit, drawn as a line; -1: none [N]",
+                                 lambda x: x == -1.0 or x > 0, "> 0 (or -1 for none)")
+    torque_limit: float = key(-1.0, "the rig's torque limit, drawn as a line; -1: none [N m]",
+                              lambda x: x == -1.0 or x > 0, "> 0 (or -1 for none)")
+    yield_strength: float = _pos("minimum yield strength of the pipe, for the weight that yields it [Pa]", 931e6)
+
+
+def _bounds(x) -> bool:
+    return len(x) == 2 and _friction_factors(x) and x[0] <= x[1]
+
+
+@dataclass(frozen=True)
+class Risk:
+    """Torque and drag under uncertainty (``fenics-drill torque-drag --samples N``): the friction factors' laws, the
+    survey's errors and its tortuosity, drawn for each realisation k from numpy default_rng([seed, k])."""
+
+    friction_cased: tuple = key((0.15, 0.35), "bounds of the cased-hole friction factor [-]", _bounds,
+                                "[low, high] with 0 <= low <= high <= 1")
+    friction_open: tuple = key((0.2, 0.4), "bounds of the open-hole friction factor [-]", _bounds,
+                               "[low, high] with 0 <= low <= high <= 1")
+    friction_cased_mean: float = key(-1.0, "mean of the cased factor; -1: none (uniform on its bounds) [-]",
+                                     lambda x: x == -1.0 or 0 <= x <= 1, "in [0, 1] (or -1 for none)")
+    friction_open_mean: float = key(-1.0, "mean of the open-hole factor; -1: none (uniform on its bounds) [-]",
+                                    lambda x: x == -1.0 or 0 <= x <= 1, "in [0, 1] (or -1 for none)")
+    friction_cased_dispersion: float = key(-1.0, "dispersion (std / mean) of the cased factor; -1: none [-]",
+                                           lambda x: x == -1.0 or x > 0, "> 0 (or -1 for none)")
+    friction_open_dispersion: float = key(-1.0, "dispersion (std / mean) of the open-hole factor; -1: none [-]",
+                                          lambda x: x == -1.0 or x > 0, "> 0 (or -1 for none)")
+    survey_error: str = key("none", "'none', or an ISCWSA error model whose systematic and global terms move the "
+                            "stations (welleng's name, e.g. 'ISCWSA MWD Rev5.11')")
+    magnetic_field: tuple = key((50e-6, 72.0, 0.0), "total field [T], dip and declination [deg] of a magnetic model",
+                                lambda x: len(x) == 3 and _positions(x) and x[0] > 0,
+                                "[total > 0, dip, declination]")
+    tortuosity_amplitude: float = _nonneg("amplitude of the sine on inclination and azimuth [deg]", 0.0)
+    tortuosity_period: float = _pos("period of the tortuosity along measured depth [m]", 30.0)
+    seed: int = key(20261202, "base seed: realisation k draws from numpy default_rng([seed, k]) [-]", _non_negative,
+                    ">= 0")
+
+
 @dataclass(frozen=True)
 class Scene:
     """A validated scene: one typed, immutable section per TOML table."""
@@ -502,6 +571,8 @@ class Scene:
     string: String = field(default_factory=String)
     fluid: Fluid = field(default_factory=Fluid)
     torque_drag: TorqueDrag = field(default_factory=TorqueDrag)
+    broomstick: Broomstick = field(default_factory=Broomstick)
+    risk: Risk = field(default_factory=Risk)
 
     def to_dict(self) -> dict[str, dict[str, Any]]:
         """The scene as nested plain values (what summary files and study directories store)."""
@@ -510,6 +581,8 @@ class Scene:
     def with_changes(self, **sections: dict[str, Any]) -> "Scene":
         """A new validated scene with some keys changed: ``scene.with_changes(drive={"rotation_speed": 5.0})``."""
         raw = self.to_dict()
+        if getattr(self, "watched_by_default", False):  # output.section = -1 follows the changed string
+            raw["output"]["section"] = -1.0
         for section, entries in sections.items():
             if not isinstance(entries, dict):
                 raise SceneError(f"with_changes({section}={entries!r}): give the keys of [{section}] as a dict, e.g. "
@@ -839,7 +912,9 @@ def validate(raw: dict[str, Any]) -> Scene:
         scene = _check_relations(Scene(**sections))
     except SceneError as err:
         raise SceneError(quoting_written(str(err), written)) from None
-    object.__setattr__(scene, "written", written)  # what the user wrote with a unit (``fenics-drill scene``)
+    object.__setattr__(scene, "written", written)
+    # output.section = -1 was resolved to the string's own section: a changed string resolves it again
+    object.__setattr__(scene, "watched_by_default", sections.get("output", Output()).section == -1.0)  # what the user wrote with a unit (``fenics-drill scene``)
     return scene
 
 

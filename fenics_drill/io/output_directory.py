@@ -59,16 +59,21 @@ OWNED = {
            FIGURE_RECORD),
     "optimize": ("summary.json", "scene.json", "points", "optimize.json", FIGURE_RECORD),
     "torque-drag": ("summary.json", "torque_drag.json", "torque_drag.h5", "well.vtu", "well_loads.png",
-                    "well_path.png", "well_3d.png", FIGURE_RECORD),
+                    "well_path.png", "well_3d.png", "risk.json", "risk.nc", "samples", "scene.json", "risk.png", FIGURE_RECORD),
+    "broomstick": ("summary.json", "broomstick.json", "broomstick.nc", "broomstick.csv", "broomstick.png",
+                   FIGURE_RECORD),
+    "calibrate": ("summary.json", "calibration.json", "broomstick.nc", "calibrated.nc", "calibration.png",
+                  "friction_track.png", FIGURE_RECORD),
 }
 #: A temporary file of an atomic write (:func:`fenics_drill.io.files.temporary_path`): ``.NAME.tmpPID``.
 TEMPORARY = re.compile(r"^\.(?P<name>.+)\.tmp\d+$")
 SIGNATURE = {"run": "timeseries.h5", "static": "static.json", "modal": "modes.json", "campbell": "campbell.json",
              "mc": "realisations", "optimize": "points",
-             "torque-drag": "torque_drag.json"}
+             "torque-drag": "torque_drag.json", "broomstick": "broomstick.json", "calibrate": "calibration.json"}
 DESCRIPTION = {"run": "a drilling run", "static": "a static equilibrium", "modal": "a modal analysis",
                "campbell": "a Campbell diagram", "mc": "a Monte Carlo study", "optimize": "an operating-window study",
-               "torque-drag": "a torque-and-drag study"}
+               "torque-drag": "a torque-and-drag study", "broomstick": "a broomstick chart",
+               "calibrate": "a friction calibration"}
 
 
 class OutputError(ValueError):

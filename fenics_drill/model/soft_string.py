@@ -21,7 +21,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
+from fenics_drill.model.kernels.compiled import kernel
 from fenics_drill.model.string_sections import StringSection, section_at
 from fenics_drill.model.well import Well
 
@@ -38,10 +40,10 @@ class Operation:
     bit_torque: float
 
 
-def operations(scene) -> list[Operation]:
-    """The operations ``torque_drag.operations`` names, with the scene's set points (:attr:`~fenics_drill.scene.Scene.
-    set_points`: the drive's, or the study's own) and torque on bit.  Sliding drills with
-    a downhole motor: the bit's weight and the motor's reactive torque, carried by a string that does not turn."""
+def operations(scene, names=None) -> list[Operation]:
+    """The operations ``names`` (default: those ``torque_drag.operations`` names), with the scene's set points
+    (:attr:`~fenics_drill.scene.Scene.set_points`: the drive's, or the study's own) and torque on bit.  Sliding drills
+    with a downhole motor: the bit's weight and the motor's reactive torque, carried by a string that does not turn."""
     td, sp = scene.torque_drag, scene.set_points
     table = {
         "rotating_on_bottom": Operation("rotating_on_bottom", sp["rate_of_penetration"], sp["rotation_speed"],
@@ -51,7 +53,7 @@ def operations(scene) -> list[Operation]:
         "tripping_in": Operation("tripping_in", td.trip_speed, 0.0, 0.0, 0.0),
         "tripping_out": Operation("tripping_out", -td.trip_speed, 0.0, 0.0, 0.0),
     }
-    return [table[name] for name in td.operations]
+    return [table[name] for name in (td.operations if names is None else names)]
 
 
 @dataclass(frozen=True)
@@ -91,42 +93,86 @@ def soft_string(mesh: StringMesh, operation: Operation, iterations: int = 50) ->
     """Effective tension [N] and torque [N m] at the nodes, from the bit up, and the wall's contact force per
     length [N/m] on each element with its direction (a unit vector, north-east-up; zero where the wall carries
     nothing), for one operation."""
-    n = mesh.md.size
-    tension, torque = np.empty(n), np.empty(n)
-    normal, direction = np.empty(n - 1), np.zeros((n - 1, 3))
-    tension[-1], torque[-1] = operation.bit_force, operation.bit_torque
-    down = np.array([0.0, 0.0, -1.0])
-    for k in range(n - 2, -1, -1):
-        a_t, a_b = mesh.tangent[k], mesh.tangent[k + 1]
-        axis = a_t + a_b
-        axis /= np.linalg.norm(axis)
-        cos_half = float(a_t @ axis)
-        ds = mesh.md[k + 1] - mesh.md[k]
-        weight = mesh.weight[k] * ds * down
-        r, mu = mesh.contact_radius[k], mesh.friction[k]
-        surface = r * operation.rotation_speed
-        slip = math.hypot(operation.axial_velocity, surface)
-        axial_share = operation.axial_velocity / slip if slip > 0 else 0.0
-        turning_share = surface / slip if slip > 0 else 0.0
-        f_b = tension[k + 1]
-        f_t = f_b + float(weight @ axis) / cos_half
-        for _ in range(iterations):
-            load = f_t * a_t - f_b * a_b - weight
-            wall = float(np.linalg.norm(load - (load @ axis) * axis))
-            updated = f_b + (float(weight @ axis) - mu * wall * axial_share) / cos_half
-            converged = abs(updated - f_t) <= 1e-12 * (abs(updated) + abs(f_b) + 1.0)
-            f_t = updated
-            if converged:
-                break
-        load = f_t * a_t - f_b * a_b - weight
-        lateral = load - (load @ axis) * axis
-        wall = float(np.linalg.norm(lateral))
-        if wall > 0.0:
-            direction[k] = lateral / wall
-        tension[k] = f_t
-        torque[k] = torque[k + 1] + mu * wall * r * turning_share
-        normal[k] = wall / ds
+    loads = soft_string_batch(mesh, [operation], mesh.friction[None, :], iterations)
+    return {name: values[0] for name, values in loads.items()}
+
+
+def soft_string_batch(mesh: StringMesh, batch: list[Operation], friction: np.ndarray, iterations: int = 50,
+                      tangents: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """:func:`soft_string` of the operations ``batch`` at once, the k-th with the friction coefficients
+    ``friction[k]`` on the elements (rows of a (B, elements) array) and, where ``tangents`` (B, nodes, 3) is given,
+    its own axis tangents at the mesh's nodes (a perturbed survey): each result with a first axis over the batch.
+    One compiled pass along the string (:func:`_soft_string_pass`), what a broomstick chart or a Monte Carlo of
+    friction factors needs (thousands of operations)."""
+    friction = np.ascontiguousarray(np.broadcast_to(np.asarray(friction, dtype=float),
+                                                    (len(batch), mesh.md.size - 1)))
+    columns = np.array([[o.axial_velocity, o.rotation_speed, o.bit_force, o.bit_torque] for o in batch], dtype=float)
+    axis = mesh.tangent[None] if tangents is None else tangents
+    tension, torque, normal, direction = _soft_string_pass(
+        mesh.md, np.ascontiguousarray(axis, dtype=float), np.asarray(mesh.weight, dtype=float),
+        np.asarray(mesh.contact_radius, dtype=float), friction, np.ascontiguousarray(columns), iterations)
     return {"tension": tension, "torque": torque, "wall_force_per_length": normal, "wall_force_direction": direction}
+
+
+@njit(cache=True)
+def _lateral_load(f_t, f_b, a_t, a_b, axis, down, load):
+    """The element's load across its axis, f_t a_t - f_b a_b minus its weight (``down`` along -z), into ``load``;
+    returns its magnitude, the wall's force on the element."""
+    for i in range(3):
+        load[i] = f_t * a_t[i] - f_b * a_b[i]
+    load[2] -= down
+    projected = load[0] * axis[0] + load[1] * axis[1] + load[2] * axis[2]
+    for i in range(3):
+        load[i] -= projected * axis[i]
+    return math.sqrt(load[0] ** 2 + load[1] ** 2 + load[2] ** 2)
+
+
+@kernel
+def _soft_string_pass(md, tangents, weight, radius, friction, operations, iterations):
+    """The element-by-element equilibrium of the module doc from the bit up, for each operation (rows of
+    ``operations``: axial velocity, rotation speed, bit force, bit torque) with its friction coefficients and its
+    axis' tangents (``tangents[b]``, or ``tangents[0]`` for all): the tension at the element's top by a fixed point on
+    the wall force it sets (converged to 1e-12)."""
+    batch, n = operations.shape[0], md.size
+    tension, torque = np.empty((batch, n)), np.empty((batch, n))
+    normal, direction = np.empty((batch, n - 1)), np.zeros((batch, n - 1, 3))
+    axis, load = np.empty(3), np.empty(3)
+    for b in range(batch):
+        tangent = tangents[b if tangents.shape[0] > 1 else 0]
+        velocity, spin = operations[b, 0], operations[b, 1]
+        tension[b, n - 1], torque[b, n - 1] = operations[b, 2], operations[b, 3]
+        for k in range(n - 2, -1, -1):
+            for i in range(3):
+                axis[i] = tangent[k, i] + tangent[k + 1, i]
+            length = math.sqrt(axis[0] ** 2 + axis[1] ** 2 + axis[2] ** 2)
+            for i in range(3):
+                axis[i] /= length
+            cos_half = tangent[k, 0] * axis[0] + tangent[k, 1] * axis[1] + tangent[k, 2] * axis[2]
+            ds = md[k + 1] - md[k]
+            down = -weight[k] * ds  # the element's weight, along -z
+            along = down * axis[2]  # its component along the axis
+            mu, r = friction[b, k], radius[k]
+            surface = r * spin
+            slip = math.hypot(velocity, surface)
+            axial_share = velocity / slip if slip > 0 else 0.0
+            turning_share = surface / slip if slip > 0 else 0.0
+            f_b = tension[b, k + 1]
+            f_t = f_b + along / cos_half
+            for _ in range(iterations):
+                wall = _lateral_load(f_t, f_b, tangent[k], tangent[k + 1], axis, down, load)
+                updated = f_b + (along - mu * wall * axial_share) / cos_half
+                converged = abs(updated - f_t) <= 1e-12 * (abs(updated) + abs(f_b) + 1.0)
+                f_t = updated
+                if converged:
+                    break
+            wall = _lateral_load(f_t, f_b, tangent[k], tangent[k + 1], axis, down, load)
+            if wall > 0.0:
+                for i in range(3):
+                    direction[b, k, i] = load[i] / wall
+            tension[b, k] = f_t
+            torque[b, k] = torque[b, k + 1] + mu * wall * r * turning_share
+            normal[b, k] = wall / ds
+    return tension, torque, normal, direction
 
 
 def stretch(mesh: StringMesh, sections: list[StringSection], tension: np.ndarray, depth: np.ndarray,

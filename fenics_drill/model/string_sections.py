@@ -14,6 +14,7 @@ pitch: exact for waves much longer than the pitch.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -157,3 +158,25 @@ def fe_sections(scene, hole_radius_at, cell_x: np.ndarray, vertex_x: np.ndarray)
         raise SceneError(f"string section '{name}' (contact radius {contact_radius[i]:g} m) does not fit the hole of "
                          f"radius {hole[i]:g} m at md = {vertex_x[i]:.1f} m")
     return FESections(cells, contact_radius, hole)
+
+
+def string_at_bit_depth(sections: list[StringSection], depth: float) -> list[StringSection]:
+    """The string with its bit at measured depth ``depth`` [m], as a rig makes it up: the same sections from the bit
+    up, the top one (drill pipe) cut or lengthened to reach the surface; where the bit is shallower than the sections
+    below the top one, the highest of them are cut too.  Sections from the surface down, as :func:`string_sections`."""
+    if depth <= 0:
+        raise ValueError(f"a bit depth must be > 0 m, got {depth!r}")
+    kept, below = [], 0.0
+    for section in reversed(sections):  # from the bit up
+        length = section.bottom - section.top
+        if section is sections[0] or below + length >= depth:
+            length = depth - below  # the top one reaches the surface
+            kept.append((section, length))
+            break
+        kept.append((section, length))
+        below += length
+    out, top = [], 0.0
+    for section, length in reversed(kept):
+        out.append(dataclasses.replace(section, top=top, bottom=top + length))
+        top += length
+    return out

@@ -49,7 +49,8 @@ def drawn_from(directory: Path) -> dict:
     except (UnreadableFile, OSError):
         summary = {}
     status = summary.get("status", "unknown")
-    for kind, name in (("torque-drag", "torque_drag.json"), ("campbell", "campbell.json"), ("modal", "modes.json"),
+    for kind, name in (("calibrate", "calibration.json"), ("broomstick", "broomstick.json"), ("risk", "risk.json"),
+                       ("torque-drag", "torque_drag.json"), ("campbell", "campbell.json"), ("modal", "modes.json"),
                        ("optimize", "optimize.json"), ("mc", "statistics.h5"),
                        ("run", "timeseries.h5"), ("static", "static_profiles.h5")):
         if (directory / name).exists():
@@ -59,7 +60,9 @@ def drawn_from(directory: Path) -> dict:
         raise NothingToPlot(f"{directory} holds no timeseries.h5 ('fenics-drill run'), statistics.h5 "
                             "('fenics-drill mc'), optimize.json ('fenics-drill optimize'), modes.json ('fenics-drill "
                             "modal'), campbell.json "
-                            "('fenics-drill campbell'), torque_drag.json ('fenics-drill torque-drag') or "
+                            "('fenics-drill campbell'), torque_drag.json or risk.json ('fenics-drill torque-drag'), "
+                            "broomstick.json "
+                            "('fenics-drill broomstick'), calibration.json ('fenics-drill calibrate') or "
                             f"static_profiles.h5 ('fenics-drill static' on a well){said}")
     state = {"kind": kind, "status": status}
     if kind == "run":
@@ -83,6 +86,14 @@ def drawn_from(directory: Path) -> dict:
 
 
 def _draw(directory: Path, kind: str, gif: bool) -> list[Path]:
+    if kind == "risk":
+        from fenics_drill.plots.risk import risk_figures
+
+        return risk_figures(directory)
+    if kind in ("broomstick", "calibrate"):
+        from fenics_drill.plots.broomstick import broomstick_figures
+
+        return broomstick_figures(directory)
     if kind == "torque-drag":
         from fenics_drill.plots.well import well_figures
 
