@@ -2,7 +2,7 @@
 PY := .venv/bin/python
 OUT ?= out
 
-.PHONY: setup docs demo demo-printed demo-as-printed reproduction test bench bench-ross campbell wells drilling drill-vbh mc optimize stick-slip clean
+.PHONY: setup docs demo demo-printed demo-as-printed reproduction test bench bench-ross campbell wells drilling drill-vbh risk mc optimize stick-slip clean
 
 setup:
 	@bash scripts/bootstrap.sh
@@ -101,6 +101,19 @@ drilling: setup
 	cp $(OUT)/bh-run/fig15_bit_rotation.png docs/figures/drilling_bit_rotation.png
 	cp $(OUT)/bh-run/torque_drag.png docs/figures/drilling_torque_drag.png
 	cp $(OUT)/bh-run/fig16b_orbit.png docs/figures/drilling_orbit.png
+
+## Torque and drag as the rig uses it (docs/torque_drag_practice.md): the VBH well's broomstick chart, its friction
+## factors calibrated from the synthetic measured file, and 1000 realisations of friction and survey uncertainty on
+## RANKS processes; the page's figures copied into docs/figures.
+risk: setup
+	$(PY) -m fenics_drill.cli broomstick demos/scenes/well_vbh.toml --overwrite --out $(OUT)/vbh-chart
+	$(PY) -m fenics_drill.cli calibrate demos/scenes/well_vbh.toml demos/scenes/well_vbh_measured.csv --overwrite \
+		--out $(OUT)/vbh-calibration
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli torque-drag demos/scenes/well_vbh.toml --samples 1000 \
+		--set "risk.survey_error='ISCWSA MWD Rev5.11'" --set risk.tortuosity_amplitude=0.5 --overwrite --out $(OUT)/vbh-risk
+	cp $(OUT)/vbh-chart/broomstick.png docs/figures/broomstick_vbh.png
+	cp $(OUT)/vbh-calibration/calibration.png docs/figures/calibration_vbh.png
+	cp $(OUT)/vbh-risk/risk.png docs/figures/risk_vbh.png
 
 ## Drilling the 3 km VBH demo well for VBH_SECONDS (default 60) on 2000 elements from the string at rest off bottom
 ## (the run docs/wells.md shows), the full order: its

@@ -536,8 +536,7 @@ class Risk:
                                            lambda x: x == -1.0 or x > 0, "> 0 (or -1 for none)")
     friction_open_dispersion: float = key(-1.0, "dispersion (std / mean) of the open-hole factor; -1: none [-]",
                                           lambda x: x == -1.0 or x > 0, "> 0 (or -1 for none)")
-    survey_error: str = key("none", "'none', or an ISCWSA error model whose systematic and global terms move the "
-                            "stations (welleng's name, e.g. 'ISCWSA MWD Rev5.11')")
+    survey_error: str = key("none", "'none', or the ISCWSA error model moving the stations, e.g. 'ISCWSA MWD Rev5.11'")
     magnetic_field: tuple = key((50e-6, 72.0, 0.0), "total field [T], dip and declination [deg] of a magnetic model",
                                 lambda x: len(x) == 3 and _positions(x) and x[0] > 0,
                                 "[total > 0, dip, declination]")

@@ -63,6 +63,7 @@ MODEL_PARTS = {
     "fenics_drill.model.well": 1,
     "fenics_drill.model.string_sections": 1,
     "fenics_drill.model.soft_string": 1,
+    "fenics_drill.model.survey_errors": 1,
     "fenics_drill.model.reduction": 2,
     "fenics_drill.model.drillstring": 3,
     "fenics_drill.model.rotating_modes": 3,

@@ -70,7 +70,7 @@ def broomstick_figure(chart, path: Path, measured: dict | None = None, calibrate
     load_ax.set_title(f"friction factors: cased {friction[0].min():g}-{friction[0].max():g}, open "
                       f"{friction[1].min():g}-{friction[1].max():g} (lighter lines: lower factors)", fontsize=9)
     block = limits.get("block_weight_N", 0.0)
-    load_ax.set_xlabel(f"indicated hook load [kN]{f' (block {block / 1e3:g} kN included)' if block else ''}")
+    load_ax.set_xlabel(f"indicated hook load [kN]{f' (block {block / 1e3:.4g} kN included)' if block else ''}")
     torque_ax.set_xlabel("surface torque [kN m]")
     load_ax.set_ylabel("bit depth (measured) [m]")
     load_ax.invert_yaxis()
@@ -81,7 +81,7 @@ def broomstick_figure(chart, path: Path, measured: dict | None = None, calibrate
     torque_ax.set_xlim(0.0, 1.15 * max(torques, limits.get("torque_limit_Nm", -1.0) / 1e3))
     for ax in (load_ax, torque_ax):
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8, loc="best")
+        ax.legend(fontsize=8, loc="upper right")  # a fixed place: "best" weighs every line of the chart
     fig.suptitle(title or "Broomstick chart")
     return save_figure(fig, path)
 

@@ -218,12 +218,12 @@ def broomstick_study(scene) -> dict:
 def chart_table(chart) -> str:
     """The chart as CSV text, one row per depth, operation and friction pair, the units in the header."""
     rows = ["bit_depth (m),operation,friction_cased (-),friction_open (-),hook_load (N),surface_torque (N*m)"]
+    cased, open_hole = chart["friction_cased"].values, chart["friction_open"].values
+    hook, torque = chart["hook_load"].values, chart["surface_torque"].values
     for i, depth in enumerate(chart["depth"].values):
         for j, name in enumerate(chart["operation"].values):
-            for p in chart["pair"].values:
-                rows.append(f"{depth:.6g},{name},{float(chart['friction_cased'][p]):.6g},"
-                            f"{float(chart['friction_open'][p]):.6g},{float(chart['hook_load'][i, j, p]):.9g},"
-                            f"{float(chart['surface_torque'][i, j, p]):.9g}")
+            rows += [f"{depth:.6g},{name},{cased[p]:.6g},{open_hole[p]:.6g},{hook[i, j, p]:.9g},{torque[i, j, p]:.9g}"
+                     for p in range(cased.size)]
     return "\n".join(rows) + "\n"
 
 
