@@ -24,7 +24,7 @@ from fenics_drill.model.forces.wall_contact import WallContact
 from fenics_drill.model.operators import assemble_linear
 from fenics_drill.model.rotating_modes import held_space, linearise_about_spin, solve_whirl_modes
 from fenics_drill.studies.lifecycle import command_output
-from fenics_drill.studies.operating_state import operating_state
+from fenics_drill.studies.operating_state import operating_state, unstable_modes
 
 RPM = 60.0 / (2.0 * math.pi)  # rad/s -> rev/min
 
@@ -75,6 +75,13 @@ def campbell_report(scene) -> dict:
     operators = assemble_linear(disc)
     preload = axial_preload(scene)
     steady = operating_state(scene, disc, operators, preload, on_wall=scene.campbell.state == "static")
+    buckled = unstable_modes(scene, disc, operators, steady)
+    if buckled:  # a buckled string has no critical speed: said, never a diagram of its unstable modes
+        first = buckled[0]
+        raise CampbellError(f"the string is buckled under {preload / 1e3:.4g} kN of axial compression: {len(buckled)} "
+                            f"mode(s) of the drive-held string have no positive stiffness (the first, {first['kind']}, "
+                            f"bends most at x = {first['largest_lateral_displacement_at_m']:.4g} m), so it has no "
+                            "critical speed; lower campbell.axial_force (or the weight on bit)")
     about = {k: v for k, v in steady.about.items() if k != "weight_on_bit_N"}
     space = held_space(disc)
     wall = [WallContact.from_scene(scene, disc, space, operators)] if steady.on_the_wall else []

@@ -24,8 +24,8 @@ from fenics_drill.model.reduction.modes import (ModalBasis, drive_held_modes, fa
 from fenics_drill.model.reduction.spaces import solution_space
 from fenics_drill.model.well import check_string_in_well
 from fenics_drill.studies.lifecycle import command_output
-from fenics_drill.studies.operating_state import (REPORTED_MODES, buckled_modes, linearised_state, loaded_stiffness,
-                                                  operating_state)
+from fenics_drill.studies.operating_state import (REPORTED_MODES, linearised_state, loaded_stiffness, operating_state,
+                                                  unstable_modes)
 
 #: The end conditions of each spectrum: the (field, end) pairs held besides the supports, and how they read.
 SPECTRA = {
@@ -123,9 +123,7 @@ def modal_report(scene) -> dict:
         reduced = {"rule": scene.reduction.rule, "size": disc.ndofs, "counts": None, "mode_indices": None,
                    "unknowns": disc.ndofs, "guard": guard}
     free = spectra["free_free"]
-    p = disc.properties
-    buckled = buckling_report(buckled_modes(spectra["drive_held_bit_off_bottom"], p.length,
-                                            p.longitudinal_wave_speed), about.get("weight_on_bit_N", 0.0)) \
+    buckled = buckling_report(unstable_modes(scene, disc, operators, state), about.get("weight_on_bit_N", 0.0)) \
         if loaded is not None else None
     return {
         "full_dofs": disc.ndofs,

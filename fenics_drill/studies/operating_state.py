@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from fenics_drill.model.discretization import DRIVE
+from fenics_drill.model.discretization import DRIVE, THETA_X, THETA_Y, THETA_Z, U, V, W
 from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.model.forces.axial_tip_load import AxialTipLoad
 from fenics_drill.model.forces.wall_contact import WallContact
@@ -107,19 +107,62 @@ def buckled_modes(held, length: float, wave_speed: float) -> list[dict]:
             for i in np.flatnonzero(held.eigenvalues <= limit)]
 
 
-def unstable_modes(scene, model: DrillstringModel, q: np.ndarray) -> list[dict]:
-    """The modes of the drive-held string that have no positive stiffness about the static state ``q`` of ``model``
-    (:func:`buckled_modes` of the prestressed tangent, :func:`loaded_stiffness`; the band up to
-    STABILITY_F_STAR): none where the state is stable."""
-    disc = model.disc
-    displacement = model.space.expand(q)
+def unstable_modes(scene, disc, operators, state: OperatingState) -> list[dict]:
+    """The modes of the drive-held string that have no positive stiffness about ``state``: none where it is stable.
+
+    Whether there is one is settled by the sign of the lowest eigenvalue of the prestressed tangent (:func:
+    `loaded_stiffness`) on the drive-held dofs (Sylvester: the generalised problem with the mass has as many negative
+    eigenvalues), a banded symmetric eigenvalue problem in the dofs' order along the string; the modes themselves
+    are the band's lowest modes (:func:`buckled_modes` up to STABILITY_F_STAR), or, where the compression is so far
+    beyond the buckling load that their frequencies lie below the band's shift, the lowest eigenvector itself."""
+    stiffness = loaded_stiffness(scene, disc, operators, state)
+    held = [disc.end_dof(field, end) for field, end in DRIVE]
+    free = np.setdiff1d(np.arange(disc.ndofs), np.union1d(disc.support_dofs, held))
+    lowest, vector = lowest_eigenpair(stiffness[free][:, free], disc.dof_coordinates[free])
+    if lowest >= -BUCKLING_ROUND_OFF * float(np.abs(stiffness.diagonal()).max()):
+        return []
+    spectrum = solve_modes(disc, STABILITY_F_STAR, operators.mass, held=DRIVE, vectors=False, stiffness=stiffness)
+    p = disc.properties
+    found = buckled_modes(spectrum, p.length, p.longitudinal_wave_speed)
+    if found:
+        return found
+    fields = disc.field_of_dof[free]
+    lateral = np.isin(fields, (V, W))
+    share = np.array([np.sum(vector[fields == f] ** 2) for f in range(6)])
+    kind = "flexural" if share[[V, W, THETA_Y, THETA_Z]].sum() >= 0.5 * share.sum() else \
+        ("axial" if share[U] >= share[THETA_X] else "torsional")
+    where = float(disc.dof_coordinates[free][lateral][np.argmax(np.abs(vector[lateral]))]) if lateral.any() else np.nan
+    return [{"index": 0, "kind": kind, "omega_squared": None, "stiffness_eigenvalue": float(lowest),
+             "largest_lateral_displacement_at_m": where}]
+
+
+#: The tangent's lowest eigenvalue below -this share of its largest diagonal entry is negative beyond round-off.
+BUCKLING_ROUND_OFF = 1e-10
+
+
+def lowest_eigenpair(matrix: sp.spmatrix, position: np.ndarray) -> tuple[float, np.ndarray]:
+    """The lowest eigenvalue of the symmetric ``matrix`` and its eigenvector, from its band once the dofs are ordered
+    by ``position`` along the string (LAPACK's banded eigensolver for the first eigenvalue alone)."""
+    from scipy.linalg import eig_banded
+
+    order = np.argsort(position, kind="stable")
+    ordered = sp.coo_matrix(matrix.tocsr()[order][:, order])
+    ordered.sum_duplicates()
+    lower = ordered.row >= ordered.col
+    width = int(np.max(ordered.row[lower] - ordered.col[lower])) if lower.any() else 0
+    band = np.zeros((width + 1, matrix.shape[0]))
+    band[ordered.row[lower] - ordered.col[lower], ordered.col[lower]] = ordered.data[lower]
+    values, vectors = eig_banded(band, lower=True, select="i", select_range=(0, 0))
+    vector = np.empty(matrix.shape[0])
+    vector[order] = vectors[:, 0]
+    return float(values[0]), vector
+
+
+def state_of(model: DrillstringModel, q: np.ndarray) -> OperatingState:
+    """The static state ``q`` of ``model`` as an OperatingState (on the wall where a vertex rests on it)."""
     wall = model.force("wall")
     on_wall = bool(wall is not None and wall.evaluate(q, np.zeros_like(q)).in_contact.any())
-    state = OperatingState(displacement, {}, on_wall)
-    stiffness = loaded_stiffness(scene, disc, model.operators, state)
-    held = solve_modes(disc, STABILITY_F_STAR, model.operators.mass, held=DRIVE, vectors=False, stiffness=stiffness)
-    p = disc.properties
-    return buckled_modes(held, p.length, p.longitudinal_wave_speed)
+    return OperatingState(model.space.expand(q), {}, on_wall)
 
 
 #: The band in which a static state's stability is judged (its lowest modes): f* = f L / c_L <= this.

@@ -40,7 +40,7 @@ from fenics_drill.solvers.step_control import (RunFailure, check_run_length, lea
                                               steps_per_band_period)
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
 from fenics_drill.studies.lifecycle import StopOnSignal, command_output, scene_record, uninterrupted
-from fenics_drill.studies.operating_state import REPORTED_MODES, unstable_modes
+from fenics_drill.studies.operating_state import REPORTED_MODES, state_of, unstable_modes
 from fenics_drill.studies.prepare import prepare
 from fenics_drill.studies.shared_run import check_ranks, check_same_state, second_rank_run, shared_model
 from fenics_drill.studies.torque_drag import fe_static_profiles, write_path_vtu
@@ -112,7 +112,8 @@ def run_static(scene, out: str | Path, overwrite: bool = False, progress: bool =
             write_atomic(out / "static_profiles.h5", lambda tmp: profiles.to_netcdf(tmp, engine="h5netcdf"))
             write_path_vtu(out / "static_path.vtu", profiles)
             report["buckling"] = static_buckling(profiles, model.vertex_gap,
-                                                 lambda: unstable_modes(scene, model, equilibrium.q))
+                                                 lambda: unstable_modes(scene, model.disc, model.operators,
+                                                                        state_of(model, equilibrium.q)))
             if report["buckling"]["unstable"]:
                 reasons = [*reasons, report["buckling"]["message"]]
                 report["suspect_reasons"] = reasons

@@ -235,3 +235,19 @@ def test_modal_above_the_first_buckling_load_reports_buckling_not_a_critical_spe
     assert main(["modal", *overrides, "--out", str(tmp_path / "modal")]) == 0
     out = capsys.readouterr().out
     assert "BUCKLED: the string is buckled at" in out and "critical speeds" not in out
+    # far beyond the load (100 times: modes so unstable that the band's shift does not reach them), still said
+    far = modal_report(load_scene(None, [*base, f"modal.weight_on_bit={100 * critical}"]))
+    assert far["buckled"] is not None and far["lateral_critical_speeds_rpm"] == []
+
+
+def test_campbell_of_a_buckled_string_says_so_instead_of_a_diagram(capsys, tmp_path):
+    """The paper's 20 m pipe straight (no wall), compressed at 1 MN, 3.6 times its fixed-pinned Euler load
+    (20.19 E I / L^2 = 279 kN): refused in one line saying it is buckled and has no critical speed."""
+    from fenics_drill.cli import main
+
+    code = main(["campbell", "--set", "beam.length=20", "--set", "beam.elements=40", "--set", "campbell.axial_force=1e6",
+                 "--set", "campbell.state='straight'", "--set", "campbell.rotation_speed=[0.0, 6.0, 2]",
+                 "--out", str(tmp_path / "c")])
+    err = capsys.readouterr().err
+    assert code == 2 and "the string is buckled under 1000 kN of axial compression" in err, err
+    assert len(err.strip().splitlines()) == 1
