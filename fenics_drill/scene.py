@@ -215,6 +215,8 @@ class Model:
                                 "'printed' (13)", choices=("consistent", "printed"))
     torsion: str = key("st_venant", "torsional stiffness: 'st_venant' (G J) or 'printed' (kappa_s G J, Table 4's; "
                        "docs/errata.md)", choices=("st_venant", "printed"))
+    lateral_length: float = key(-1.0, "length above the bit whose lateral fields are solved; -1: all, 0: none [m]",
+                                lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for the whole string)")
 
 
 def _positions(x) -> bool:
@@ -760,6 +762,9 @@ def _check_relations(scene: Scene) -> Scene:
                          f"must be in [0, {what} = {length!r}]")
     _check_stabilisers(scene)
     _check_well_keys(scene)
+    if scene.model.lateral_length > length * (1 + 1e-12):
+        raise SceneError(f"model.lateral_length = {scene.model.lateral_length!r} is not admissible: must be <= the "
+                         f"string's length, {length!r} m (or -1 for the whole string)")
     contact = scene.contact
     if contact.friction_model == "coulomb":
         for name in ("axial_friction_law", "friction_torque_law"):

@@ -65,18 +65,22 @@ class BeamDiscretization:
     """The interval mesh [0, L], the mixed space and the dofs of each field (serial, COMM_SELF)."""
 
     def __init__(self, properties: BeamProperties, elements: int, element_degree: int = 2, supports: str = "paper",
-                 stabilisers: tuple = (), trajectory: Trajectory | None = None, sections=None, breaks: tuple = ()):
+                 stabilisers: tuple = (), trajectory: Trajectory | None = None, sections=None, breaks: tuple = (),
+                 lateral_length: float = -1.0):
         """``stabilisers``: x of pinned lateral supports inside the string (v = w = 0 at the nearest vertex);
         ``trajectory``: the well's axis the string lies along from its top (x = measured depth), or None for the
         straight horizontal hole; ``sections``: None for one pipe (``properties``), or what the string is made of
         along x, ``sections(cell midpoints, vertex x)`` -> :class:`~fenics_drill.model.string_sections.FESections`
         (``properties`` then holds the section at the bit, for what needs one number); ``breaks``: x where a
-        vertex must fall (the ends of sections and of the survey's arcs: :func:`mesh_vertices`)."""
+        vertex must fall (the ends of sections and of the survey's arcs: :func:`mesh_vertices`);
+        ``lateral_length``: the length above the bit over which v, w, theta_y and theta_z are solved (-1: the whole
+        string; 0: none, an axial-torsional string): above it they are held at zero (:attr:`lateral_held_dofs`)."""
         if supports not in SUPPORTS:
             raise ValueError(f"unknown supports {supports!r}; expected one of {', '.join(SUPPORTS)}")
         self.element_degree = element_degree
         self.supports = supports
         self.stabilisers = tuple(stabilisers)
+        self.lateral_length = lateral_length
         self.comm = MPI.COMM_SELF
         if breaks:
             x = mesh_vertices(properties.length, elements, breaks)
@@ -163,9 +167,10 @@ class BeamDiscretization:
         is the string's) in the hole sections of ``[well]``."""
         check_memory(scene.beam.elements, scene.beam.element_degree)
         sectioned = bool(scene.string.sections or scene.well.hole_radius)
+        lateral = scene.model.lateral_length
         if not (sectioned or scene.well.survey or scene.well.md):
             return cls(scene.beam_properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports,
-                       scene.supports.stabilisers)
+                       scene.supports.stabilisers, lateral_length=lateral)
         strings = string_sections(scene)
         well = well_of(scene, strings[-1].bottom)
         properties = replace(scene.beam_properties, length=strings[-1].bottom)
@@ -175,9 +180,10 @@ class BeamDiscretization:
         # than the mesh (a station every few cm) would make the mesh its own: its elements then take the
         # curvature at their midpoints
         stations = well.trajectory.md if trajectory and len(well.trajectory.md) <= scene.beam.elements else ()
-        breaks = (*(s.bottom for s in strings), *well.hole.bottoms, *stations)
+        top = (strings[-1].bottom - lateral,) if lateral > 0 else ()  # a vertex at the lateral length's top
+        breaks = (*(s.bottom for s in strings), *well.hole.bottoms, *stations, *top)
         return cls(properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports,
-                   scene.supports.stabilisers, trajectory, layout, breaks)
+                   scene.supports.stabilisers, trajectory, layout, breaks, lateral)
 
     @property
     def ndofs(self) -> int:
@@ -215,17 +221,49 @@ class BeamDiscretization:
         return [(field, int(self.vertex_dofs(field)[i])) for i in self.stabiliser_vertices for field in (V, W)]
 
     @cached_property
+    def lateral_top(self) -> float:
+        """x of the top of the length whose lateral fields are solved (0: the whole string; the vertex nearest
+        L - ``lateral_length``; L for an axial-torsional string)."""
+        if self.lateral_length < 0:
+            return 0.0
+        if self.lateral_length == 0:
+            return self.properties.length
+        return float(self.vertex_x[np.argmin(np.abs(self.vertex_x - (self.properties.length - self.lateral_length)))])
+
+    @cached_property
+    def lateral_held_dofs(self) -> list[tuple[int, int]]:
+        """(field, dof) of the lateral dofs held at zero above the lateral length (``lateral_length``): every v, w,
+        theta_y, theta_z above :attr:`lateral_top`, and v, w at it (the string's axis there: the lateral part is
+        pinned on the well's axis at its top, its tilt free); every one of them for an axial-torsional string."""
+        if self.lateral_length < 0:
+            return []
+        top, whole = self.lateral_top, self.lateral_length == 0
+        tolerance = 1e-9 * self.properties.length
+        held = []
+        for field in (V, W, THETA_Y, THETA_Z):
+            x = self.dof_coordinates[self.field_dofs[field]]
+            above = (x < top - tolerance) | (whole | (field in (V, W))) & (x <= top + tolerance)
+            held += [(field, int(dof)) for dof in self.field_dofs[field][above]]
+        return held
+
+    @cached_property
     def support_dofs(self) -> np.ndarray:
-        """Dofs held at zero by the supports and stabilisers (the Dirichlet rows of the modal problem)."""
+        """Dofs held at zero by the supports, the stabilisers and the lateral length (the Dirichlet rows of the modal
+        problem)."""
         ends = [self.end_dof(f, e) for f, e in SUPPORTS[self.supports]]
-        return np.array(sorted(ends + [dof for _, dof in self._stabiliser_dofs()]), dtype=np.int32)
+        extra = [dof for _, dof in self._stabiliser_dofs()] + [dof for _, dof in self.lateral_held_dofs]
+        return np.unique(np.array(ends + extra, dtype=np.int32))
 
     def support_bcs(self, held: tuple = ()) -> list[fem.DirichletBC]:
-        """Homogeneous Dirichlet conditions for the supports, the stabilisers and the ``held`` (field, end)
-        pairs (for example :data:`DRIVE`), one per constrained dof."""
+        """Homogeneous Dirichlet conditions for the supports, the stabilisers, the lateral length and the ``held``
+        (field, end) pairs (for example :data:`DRIVE`), one per field and set of constrained dofs."""
         dofs = [(field, self.end_dof(field, end)) for field, end in (*SUPPORTS[self.supports], *held)]
-        return [fem.dirichletbc(np.float64(0.0), np.array([dof], dtype=np.int32), self.V.sub(field))
-                for field, dof in dofs + self._stabiliser_dofs()]
+        dofs += self._stabiliser_dofs() + self.lateral_held_dofs
+        by_field = {}
+        for field, dof in dofs:
+            by_field.setdefault(field, set()).add(dof)
+        return [fem.dirichletbc(np.float64(0.0), np.array(sorted(d), dtype=np.int32), self.V.sub(field))
+                for field, d in by_field.items()]
 
     @cached_property
     def dof_coordinates(self) -> np.ndarray:

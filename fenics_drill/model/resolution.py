@@ -48,7 +48,8 @@ TENSION_SAMPLES = 2
 def nodes_per_wavelength(scene) -> float:
     """Displacement nodes of the mesh (elements x degree over the length) per flexural wavelength at f_max, where
     it is the shortest: each section's pipe (its homogenised tool joints' bending stiffness included) under the
-    tension it hangs with in a well (:func:`hanging_tension`), or unloaded in the straight horizontal hole."""
+    tension it hangs with in a well (:func:`hanging_tension`), or unloaded in the straight horizontal hole; only
+    along the lateral length (``model.lateral_length``) where the lateral fields are not solved everywhere."""
     b = scene.beam
     length = scene.string_length
     spacing = length / (b.elements * b.element_degree)
@@ -57,19 +58,25 @@ def nodes_per_wavelength(scene) -> float:
         md = np.linspace(0.0, length, TENSION_SAMPLES * b.elements + 1)
         return float(np.min(flexural_wavelength(p, f_max, hanging_tension(scene, md, scene.modal_weight_on_bit)))) / spacing
     sections = string_sections(scene)
+    lateral_top = length - scene.model.lateral_length if scene.model.lateral_length > 0 else 0.0
     shortest = np.inf
     for s in sections:
+        if s.bottom <= lateral_top:
+            continue  # held on the axis: no bending
         pipe = replace(p, outer_radius=s.outer_radius, inner_radius=s.inner_radius, young_modulus=s.young_modulus,
                        density=s.mass_per_length / (math.pi * (s.outer_radius**2 - s.inner_radius**2)),
                        inertia_stiffness_factor=s.stiffness_factors[1])
-        md = np.linspace(s.top, s.bottom, max(2, math.ceil(TENSION_SAMPLES * b.elements * (s.bottom - s.top) / length)))
+        top = max(s.top, lateral_top)
+        md = np.linspace(top, s.bottom, max(2, math.ceil(TENSION_SAMPLES * b.elements * (s.bottom - top) / length)))
         shortest = min(shortest, float(np.min(flexural_wavelength(pipe, f_max,
                                                                    hanging_tension(scene, md, scene.modal_weight_on_bit)))))
     return shortest / spacing
 
 
 def mesh_advice(scene) -> str | None:
-    """Why the mesh is too coarse for the band, or None."""
+    """Why the mesh is too coarse for the band, or None (an axial-torsional string has no bending to resolve)."""
+    if scene.model.lateral_length == 0:
+        return None
     nodes = nodes_per_wavelength(scene)
     if nodes >= MIN_NODES_PER_WAVELENGTH:
         return None

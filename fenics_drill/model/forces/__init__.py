@@ -6,6 +6,7 @@ derivative; all implement :class:`~fenics_drill.model.forces.protocol.PointForce
 entry in :data:`FORCES` and one scene section (docs/architecture.md).
 """
 
+from fenics_drill.model.forces.axial_torsional_wall import AxialTorsionalWall
 from fenics_drill.model.forces.bit_rock import BitRock
 from fenics_drill.model.forces.cutting_bit import CuttingBit
 from fenics_drill.model.forces.gravity import Gravity
@@ -13,7 +14,7 @@ from fenics_drill.model.forces.protocol import ForceEvaluation, PointForce
 from fenics_drill.model.forces.wall_contact import WallContact
 
 #: Every force the model knows, in the order their generalised forces are summed.
-FORCES = (Gravity, WallContact, BitRock, CuttingBit)
+FORCES = (Gravity, WallContact, AxialTorsionalWall, BitRock, CuttingBit)
 
 
 def _chosen(force, scene) -> bool:
@@ -32,5 +33,5 @@ def recorded_variables() -> dict[str, tuple[str, str]]:
     return {name: meta for force in FORCES for name, meta in force.recorded.items()}
 
 
-__all__ = ["FORCES", "BitRock", "CuttingBit", "ForceEvaluation", "Gravity", "PointForce", "WallContact", "build_forces",
+__all__ = ["FORCES", "AxialTorsionalWall", "BitRock", "CuttingBit", "ForceEvaluation", "Gravity", "PointForce", "WallContact", "build_forces",
            "recorded_variables"]

@@ -1,0 +1,178 @@
+"""The wall where the lateral fields are not solved (``model.lateral_length``): one Coulomb force at each vertex's
+contact point, pressed by the normal force the soft string's static state gives there.
+
+Above the lateral length the string lies on the well's axis (its lateral fields held at zero), so the wall's
+springs (17) never press it; the wall acts through its friction on the axial and torsional motion.  At vertex i the
+normal force is N_i, the soft string's wall force per length (:mod:`~fenics_drill.model.soft_string`, the scene's
+operation: rotating on bottom for a run that starts on bottom, off bottom otherwise, with the wall's friction
+``contact.friction``) integrated over the half elements beside the vertex.  The contact point slips axially by
+u_i and around the pipe by R_i theta_x,i (R_i the contact radius); the Coulomb force F = (F_a, F_t) follows by the
+return mapping of the FE wall (:func:`~fenics_drill.model.forces.wall.coulomb.coulomb_friction`): from the force
+held at the step's start, the trial F* = F_0 - k_t g of the slip g since then, kept while |F*| <= mu N_i (stuck: no
+creep under a force below the cone), scaled onto the cone above it (sliding against the slip, so that rotation
+takes the axial drag away).  On the string it acts as F_a on u_i and R_i F_t on theta_x,i.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+import scipy.sparse as sp
+
+from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
+from fenics_drill.model.forces.protocol import ForceEvaluation
+from fenics_drill.model.forces.wall.coulomb import coulomb_friction
+from fenics_drill.model.soft_string import operations, soft_string, string_mesh
+from fenics_drill.model.string_sections import string_sections
+from fenics_drill.model.well import straight_survey, well_of
+
+
+@dataclass
+class AxialTorsionalWallForces(ForceEvaluation):
+    """The friction at the vertices at one state: (F_a, F_t) each, whether each vertex slides, and its trial size."""
+
+    axial: np.ndarray = None
+    tangential: np.ndarray = None
+    trial: np.ndarray = None
+
+
+def vertex_normal_forces(scene, disc: BeamDiscretization) -> np.ndarray:
+    """N_i [N] at every vertex: the soft string's wall force per length of the scene's operation (module doc),
+    integrated over the half elements beside each vertex."""
+    sections = string_sections(scene)
+    g = scene.environment.gravity if scene.model.gravity else 0.0
+    weights = np.array([s.buoyed_weight(g, scene.fluid.density, scene.inner_fluid_density) for s in sections])
+    if scene.well.survey or scene.well.md:
+        well = well_of(scene, sections[-1].bottom)
+    else:  # the paper's straight horizontal hole
+        from fenics_drill.model.well import HoleSections, Trajectory, Well
+
+        length = sections[-1].bottom
+        well = Well(Trajectory(straight_survey(length)), HoleSections(np.array([length]),
+                                                                      np.array([scene.borehole.radius]),
+                                                                      np.array([False])))
+    mu = scene.contact.friction
+    mesh = string_mesh(well, sections, min(scene.torque_drag.element_length, float(np.diff(disc.vertex_x).min())),
+                       weights, mu, mu)
+    name = "rotating_on_bottom" if scene.starts_on_bottom else "rotating_off_bottom"
+    per_length = soft_string(mesh, operations(scene, [name])[0])["wall_force_per_length"]
+    carried = np.concatenate([[0.0], np.cumsum(per_length * np.diff(mesh.md))])  # the wall's force above each node
+    x = disc.vertex_x
+    middle = np.concatenate([[x[0]], 0.5 * (x[1:] + x[:-1]), [x[-1]]])
+    return np.diff(np.interp(middle, mesh.md, carried))
+
+
+class AxialTorsionalWall:
+    """The Coulomb friction of the wall at the vertices whose lateral fields are held (module doc)."""
+
+    name: ClassVar[str] = "axial_torsional_wall"
+    switch: ClassVar[str] = "contact"
+    conservative: ClassVar[bool] = False
+    recorded: ClassVar[dict] = {"vertices_stuck_on_the_wall": ("-", "vertices whose wall friction sticks "
+                                                                    "(axial-torsional length)")}
+
+    def __init__(self, disc: BeamDiscretization, space, normal: np.ndarray, arm: np.ndarray, friction: float,
+                 stick_stiffness: float):
+        self.vertices = np.flatnonzero(disc.vertex_x < disc.lateral_top - 1e-9 * disc.properties.length) \
+            if disc.lateral_length != 0 else np.arange(len(disc.vertex_x))
+        self.rows = space.point_rows(np.concatenate([disc.vertex_dofs(U)[self.vertices],
+                                                     disc.vertex_dofs(THETA_X)[self.vertices]]))
+        self.normal, self.arm = normal[self.vertices], arm[self.vertices]
+        self.friction, self.stick_stiffness = friction, stick_stiffness
+        self.space = space
+        self._history = None  # (u, theta_x) and (F_a, F_t) at the last accepted state; None outside a run
+
+    @classmethod
+    def chosen(cls, scene) -> bool:
+        """Only where some lateral fields are not solved."""
+        return scene.model.lateral_length >= 0
+
+    @classmethod
+    def from_scene(cls, scene, disc, space, operators) -> "AxialTorsionalWall":
+        contact_radius, _ = disc.vertex_radii(scene.borehole.radius)
+        return cls(disc, space, vertex_normal_forces(scene, disc), contact_radius, scene.contact.friction,
+                   scene.contact.stick_stiffness)
+
+    def fresh(self) -> "AxialTorsionalWall":
+        changed = AxialTorsionalWall.__new__(AxialTorsionalWall)
+        changed.__dict__.update(self.__dict__)
+        changed._history = None
+        return changed
+
+    def _positions(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        values = self.rows.values(q)
+        n = self.vertices.size
+        return values[:n], values[n:]
+
+    def begin(self, t: float, q: np.ndarray) -> None:
+        """Anchor the friction at the initial state, holding no force yet."""
+        u, theta = self._positions(q)
+        self._history = (u, theta, np.zeros_like(u), np.zeros_like(u))
+
+    def accept(self, t: float, q: np.ndarray, qd: np.ndarray) -> None:
+        """Anchor the friction at an accepted state, holding the force each vertex feels there."""
+        if self._history is None:
+            return
+        forces = self.evaluate(q, qd)
+        u, theta = self._positions(q)
+        self._history = (u, theta, forces.axial, forces.tangential)
+
+    def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> AxialTorsionalWallForces:
+        n = self.vertices.size
+        if self._history is None or n == 0:  # at rest (a static state): no friction
+            zero = np.zeros(n)
+            return AxialTorsionalWallForces(np.zeros(self.space.size), 0.0, {self.name: np.zeros(self.space.size)},
+                                            zero, zero, zero)
+        u, theta = self._positions(q)
+        u0, theta0, held_a, held_t = self._history
+        axial_slip, tangential_slip = u - u0, self.arm * (theta - theta0)
+        trial_a = held_a - self.stick_stiffness * axial_slip
+        trial_t = held_t - self.stick_stiffness * tangential_slip
+        f_a, f_t = coulomb_friction(-self.normal, held_a, held_t, axial_slip, tangential_slip, self.friction,
+                                    self.stick_stiffness)
+        generalised = self.rows.spread(np.concatenate([f_a, self.arm * f_t]))
+        return AxialTorsionalWallForces(generalised, 0.0, {self.name: generalised}, f_a, f_t,
+                                        np.hypot(trial_a, trial_t))
+
+    def tangent(self, forces: AxialTorsionalWallForces, c_u: float, c_v: float):
+        """c_u d/dq of (F_a, R F_t) by (u, R theta_x) per vertex: stuck, -k_t; sliding on the cone (F = M e,
+        e = F* / |F*|), -k_t M (I - e e^T) / |F*|."""
+        n = self.vertices.size
+        if self._history is None or n == 0:
+            return None
+        cap = self.friction * np.abs(self.normal)
+        sliding = forces.trial > cap
+        shrink = np.where(sliding, cap / np.maximum(forces.trial, 1e-300), 1.0)
+        e_a = np.where(sliding, forces.axial / np.maximum(cap, 1e-300), 0.0)
+        e_t = np.where(sliding, forces.tangential / np.maximum(cap, 1e-300), 0.0)
+        k = -c_u * self.stick_stiffness * shrink
+        r = self.arm
+        # d(F_a, F_t) / d(g_a, g_t) = k (I - s e e^T), g = (u, r theta): the rows of theta_x carry r, its columns r
+        s = sliding.astype(float)
+        aa, at, tt = k * (1 - s * e_a * e_a), -k * s * e_a * e_t, k * (1 - s * e_t * e_t)
+        return self._block_diagonal(aa, at * r, r * r * tt)
+
+    def _block_diagonal(self, uu: np.ndarray, ut: np.ndarray, tt: np.ndarray):
+        """P^T B P for the 2 x 2 blocks [[uu, ut], [ut, tt]] of each vertex's (u, theta_x): scattered into the
+        sparse tangent of the full space, or as the dense product with the rows of a modal basis."""
+        n = self.vertices.size
+        if self.space.sparse:
+            where = self.rows.positions
+            pu, pt = where[:n], where[n:]
+            rows = np.concatenate([pu, pu, pt, pt])
+            columns = np.concatenate([pu, pt, pu, pt])
+            data = np.concatenate([uu, ut, ut, tt])
+            kept = (rows >= 0) & (columns >= 0)
+            size = self.space.size
+            return sp.csr_matrix((data[kept], (rows[kept], columns[kept])), shape=(size, size))
+        rows = self.rows.dense()
+        ru, rt = rows[:n], rows[n:]
+        return (ru.T @ (uu[:, None] * ru) + ru.T @ (ut[:, None] * rt) + rt.T @ (ut[:, None] * ru)
+                + rt.T @ (tt[:, None] * rt))
+
+    def record(self, forces: AxialTorsionalWallForces) -> dict[str, float]:
+        cap = self.friction * np.abs(self.normal)
+        stuck = np.count_nonzero((forces.trial <= cap) & (cap > 0)) if forces.trial is not None else 0
+        return {"vertices_stuck_on_the_wall": int(stuck)}
