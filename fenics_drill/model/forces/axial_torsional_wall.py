@@ -15,6 +15,7 @@ takes the axial drag away).  On the string it acts as F_a on u_i and R_i F_t on 
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -26,7 +27,7 @@ from fenics_drill.model.forces.protocol import ForceEvaluation
 from fenics_drill.model.forces.wall.coulomb import coulomb_friction
 from fenics_drill.model.soft_string import operations, soft_string, string_mesh
 from fenics_drill.model.string_sections import string_sections
-from fenics_drill.model.well import straight_survey, well_of
+from fenics_drill.model.well import well_of
 
 
 @dataclass
@@ -44,15 +45,7 @@ def vertex_normal_forces(scene, disc: BeamDiscretization) -> np.ndarray:
     sections = string_sections(scene)
     g = scene.environment.gravity if scene.model.gravity else 0.0
     weights = np.array([s.buoyed_weight(g, scene.fluid.density, scene.inner_fluid_density) for s in sections])
-    if scene.well.survey or scene.well.md:
-        well = well_of(scene, sections[-1].bottom)
-    else:  # the paper's straight horizontal hole
-        from fenics_drill.model.well import HoleSections, Trajectory, Well
-
-        length = sections[-1].bottom
-        well = Well(Trajectory(straight_survey(length)), HoleSections(np.array([length]),
-                                                                      np.array([scene.borehole.radius]),
-                                                                      np.array([False])))
+    well = well_of(scene, sections[-1].bottom)  # the paper's straight horizontal hole without a survey
     mu = scene.contact.friction
     mesh = string_mesh(well, sections, min(scene.torque_drag.element_length, float(np.diff(disc.vertex_x).min())),
                        weights, mu, mu)
@@ -96,8 +89,8 @@ class AxialTorsionalWall:
                    scene.contact.stick_stiffness)
 
     def fresh(self) -> "AxialTorsionalWall":
-        changed = AxialTorsionalWall.__new__(AxialTorsionalWall)
-        changed.__dict__.update(self.__dict__)
+        """A copy whose friction has no memory yet (a simulation's results never depend on another's)."""
+        changed = copy.copy(self)
         changed._history = None
         return changed
 
