@@ -93,7 +93,9 @@ class BeamDiscretization:
         sub = [basix.ufl.element("Lagrange", "interval", d) for d in field_degrees(self.element_degree)]
         self.V = fem.functionspace(self.mesh, basix.ufl.mixed_element(sub))
         self.trajectory = trajectory
-        self.properties = properties if trajectory is None else replace(properties, axis=self._axis(trajectory))
+        self.properties = properties
+        if trajectory is not None:
+            self.properties = replace(properties, axis=self._axis(trajectory))
         self.sections = None
         #: What the forms take: :attr:`properties`, with each section's values on its cells for a string of sections.
         self.form_properties = self.properties
@@ -148,10 +150,19 @@ class BeamDiscretization:
 
     def _axis(self, trajectory: Trajectory) -> CurvedAxis:
         """The well's axis on the mesh: its curvature in the Bishop frame at each cell's midpoint (constant along
-        each arc of the survey) and the downward vertical in the frame at each vertex, interpolated linearly."""
+        each arc of the survey) and the downward vertical in the frame at each vertex, interpolated linearly.
+
+        Above :attr:`lateral_top` the curvature is 0: there the string has no lateral fields and lies on the hole's
+        axis whatever its axial motion, so u is an arc length along the axis and a slide along it strains nothing
+        (the curved beam's coupling k u would be a shear strain against the held lateral fields, a spurious spring
+        G A k^2 u^2 on the string's axial motion: 40 kN of the hook load through the 4.5 deg/30 m build of the
+        build-and-hold demo well).  Gravity keeps the axis' frame."""
         vertices = fem.functionspace(self.mesh, ("Lagrange", 1))
-        frames = trajectory.bishop_frames(self.cell_space.tabulate_dof_coordinates()[:, 0])
-        curvature = (self._cell_function("k2", frames.k2), self._cell_function("k3", frames.k3))
+        cell_x = self.cell_space.tabulate_dof_coordinates()[:, 0]
+        frames = trajectory.bishop_frames(cell_x)
+        followed = cell_x < self.lateral_top  # the cells of the string without lateral fields
+        curvature = tuple(self._cell_function(name, np.where(followed, 0.0, k))
+                          for name, k in (("k2", frames.k2), ("k3", frames.k3)))
         down = trajectory.bishop_frames(vertices.tabulate_dof_coordinates()[:, 0]).down()
         components = tuple(fem.Function(vertices, name=name) for name in ("down_t", "down_2", "down_3"))
         for i, component in enumerate(components):

@@ -30,11 +30,13 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
+from numba import njit
 
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
 
 
+@njit(cache=True, inline="always")
 def clip_ramp(x: float, low: float = 0.0) -> tuple[float, float]:
     """(clip(x, low, 1), its slope)."""
     if x <= low:
@@ -42,6 +44,45 @@ def clip_ramp(x: float, low: float = 0.0) -> tuple[float, float]:
     if x >= 1.0:
         return 1.0, 0.0
     return x, 1.0
+
+
+@njit(cache=True)
+def surface_at(angles, surfaces, pruned, feed, angle):
+    """(S(angle), dS/dangle) of the recorded surface (``angles`` increasing): linear between its entries, the
+    last one beyond them, and before the first the steady drilling at ``feed`` [m/rad] (its last entry where
+    older ones were dropped, ``pruned``)."""
+    if angle <= angles[0]:
+        if pruned:
+            return surfaces[0], 0.0
+        return surfaces[0] - (angles[0] - angle) * feed, feed  # steady drilling before t = 0
+    k = np.searchsorted(angles, angle)
+    if k >= angles.size:
+        return surfaces[-1], 0.0
+    slope = (surfaces[k] - surfaces[k - 1]) / (angles[k] - angles[k - 1])
+    return surfaces[k - 1] + slope * (angle - angles[k - 1]), slope
+
+
+@njit(cache=True)
+def cutting_law(u, u_dot, omega, cut, slope, blades, zeta_eps_a, eps_a2_half, contact_force, torque_arm,
+                contact_velocity, contact_depth, spin_scale):
+    """The law (module doc) at the bit's (u, u_dot, omega) over the surface (``cut``, ``slope``) one blade passage
+    behind: (d, force on u(L), torque on theta_x(L), d(force, torque)/d(u, phi) row by row, d force/d u_dot,
+    d torque/d u_dot, d torque/d omega); the force's derivative by omega is 0."""
+    cutting = u > cut
+    d = blades * (u - cut) if cutting else 0.0
+    dd_u, dd_phi = (blades, -blades * slope) if cutting else (0.0, 0.0)  # d(d) / d(u, phi)
+    g_v, dg_v = clip_ramp(u_dot / contact_velocity, 0.0)
+    g_d, dg_d = clip_ramp(d / contact_depth, 0.0)
+    contact = contact_force * g_v * g_d
+    contact_by_d = contact_force * g_v * dg_d / contact_depth
+    d_contact_v = contact_force * dg_v / contact_velocity * g_d
+    weight = zeta_eps_a * d + contact
+    magnitude = eps_a2_half * d + torque_arm * contact
+    s, ds = clip_ramp(omega / spin_scale, -1.0)
+    weight_by_d = zeta_eps_a + contact_by_d
+    torque_by_d = (eps_a2_half + torque_arm * contact_by_d) * s
+    return (d, -weight, -magnitude * s, -weight_by_d * dd_u, -weight_by_d * dd_phi, -torque_by_d * dd_u,
+            -torque_by_d * dd_phi, -d_contact_v, -torque_arm * d_contact_v * s, -magnitude * ds / spin_scale)
 
 
 class CutSurface:
@@ -71,18 +112,9 @@ class CutSurface:
         return self._surface[self._start:self._end]
 
     def at(self, angle: float) -> tuple[float, float]:
-        """(S(angle), dS/dangle)."""
-        angles, surfaces = self.angles, self.surfaces
-        if angle <= angles[0]:
-            if self._pruned:
-                return float(surfaces[0]), 0.0
-            return float(surfaces[0] - (angles[0] - angle) * self.feed), self.feed  # steady drilling before t = 0
-        k = int(np.searchsorted(angles, angle))
-        if k >= len(angles):
-            return float(surfaces[-1]), 0.0
-        a0, a1, s0, s1 = angles[k - 1], angles[k], surfaces[k - 1], surfaces[k]
-        slope = (s1 - s0) / (a1 - a0)
-        return float(s0 + slope * (angle - a0)), float(slope)
+        """(S(angle), dS/dangle) (:func:`surface_at`)."""
+        value, slope = surface_at(self.angles, self.surfaces, self._pruned, self.feed, float(angle))
+        return float(value), float(slope)
 
     def previous_pass(self, angle: float) -> tuple[float, float]:
         """(S, dS/dangle) one blade passage behind ``angle``: what the blade at ``angle`` cuts into."""
@@ -148,6 +180,9 @@ class CuttingBit:
         self.contact_torque_arm = bit.friction * bit.geometry_factor * a / 2.0  # T_f = mu gamma a W_f / 2
         self.contact_velocity, self.contact_depth = bit.contact_velocity, bit.contact_depth
         self.spin_scale = bit.contact_velocity / a
+        #: :func:`cutting_law`'s constants after the bit's state and the surface.
+        self.law_constants = (float(self.blades), *self.cutting, self.contact_force, self.contact_torque_arm,
+                              self.contact_velocity, self.contact_depth, self.spin_scale)
 
     @classmethod
     def chosen(cls, scene) -> bool:
@@ -198,26 +233,9 @@ class CuttingBit:
             cut, slope = u, 0.0  # at rest before drilling: the bit sits on the bottom, nothing to cut
         else:
             cut, slope = self.surface.previous_pass(phi)
-        n = self.blades
-        cutting = u > cut
-        d = n * (u - cut) if cutting else 0.0
-        dd = np.array([n, -n * slope]) if cutting else np.zeros(2)  # d(d) / d(u, phi)
-        g_v, dg_v = clip_ramp(u_dot / self.contact_velocity)
-        g_d, dg_d = clip_ramp(d / self.contact_depth)
-        contact = self.contact_force * g_v * g_d
-        d_contact_q = self.contact_force * g_v * dg_d / self.contact_depth * dd
-        d_contact_v = self.contact_force * dg_v / self.contact_velocity * g_d
-        zeta_eps_a, eps_a2_half = self.cutting
-        weight = zeta_eps_a * d + contact
-        magnitude = eps_a2_half * d + self.contact_torque_arm * contact
-        s, ds = clip_ramp(omega / self.spin_scale, -1.0)
-        torque = magnitude * s
-        d_weight_q = zeta_eps_a * dd + d_contact_q
-        d_torque_q = (eps_a2_half * dd + self.contact_torque_arm * d_contact_q) * s
-        jac_q = -np.array([d_weight_q, d_torque_q])
-        jac_qd = -np.array([[d_contact_v, 0.0],
-                            [self.contact_torque_arm * d_contact_v * s, magnitude * ds / self.spin_scale]])
-        f_u, f_t = -weight, -torque
+        d, f_u, f_t, *law = cutting_law(u, u_dot, omega, cut, slope, *self.law_constants)
+        jac_q = np.array(law[:4]).reshape(2, 2)
+        jac_qd = np.array([[law[4], 0.0], [law[5], law[6]]])
         laws = {"bit_rock_force": f_u * self._unit_loads[0], "bit_rock_torque": f_t * self._unit_loads[1]}
         generalised = laws["bit_rock_force"] + laws["bit_rock_torque"]
         return CuttingForces(generalised, 0.0, laws, d, f_u, f_t, jac_q, jac_qd)

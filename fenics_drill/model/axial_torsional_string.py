@@ -1,0 +1,99 @@
+"""The string's axial and torsional fields alone, as one narrow band: what a stick-slip study steps.
+
+With ``model.lateral_length = 0`` the string has no lateral fields: it lies on the well's axis, and its energies
+(44)-(46), (52) restricted to u and theta_x are linear in them (the forms' nonlinear terms all carry v, w, theta_y or
+theta_z).  :func:`axial_torsional_string` assembles M, C and K from those forms on the scene's own mesh and sections,
+keeps the rows and columns of u and theta_x, and orders them along the string (u before theta_x at one x), which
+makes them a band of half-width 3-4 for quadratic u and linear theta_x.  The wall acts through its Coulomb friction
+at each vertex, pressed by the soft string's normal force (:func:`~fenics_drill.model.forces.axial_torsional_wall.
+vertex_normal_forces`), and the top drive's inertia sits on theta_x(0) where a controller drives it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
+from fenics_drill.model.forces.axial_torsional_wall import vertex_normal_forces
+from fenics_drill.model.operators import assemble_linear
+
+
+@dataclass(frozen=True)
+class AxialTorsionalString:
+    """M, C, K of the string's (u, theta_x) in band storage (``band[i, j - i + half_width] = A[i, j]``), its gravity
+    load, and where its ends and wall vertices are among the band's dofs.  SI units."""
+
+    x: np.ndarray  # measured depth of each dof [m]
+    angle: np.ndarray  # True where the dof is theta_x
+    half_width: int
+    mass: np.ndarray
+    damping: np.ndarray
+    stiffness: np.ndarray
+    gravity: np.ndarray  # F_G (52) on the dofs [N]
+    top: tuple[int, int]  # (u(0), theta_x(0))
+    bit: tuple[int, int]  # (u(L), theta_x(L))
+    wall_dofs: np.ndarray  # (vertices, 2): u and theta_x of each vertex
+    wall_normal: np.ndarray  # the soft string's normal force at each vertex [N]
+    wall_arm: np.ndarray  # the contact radius at each vertex [m]
+    polar_inertia_at_top: float  # rho I_p of the top section [kg m]
+    torsional_wave_speed_at_top: float  # [m/s]
+    axial_wave_speed: float  # the fastest section's sqrt(E A / rho A) [m/s]
+    length: float
+
+    @property
+    def size(self) -> int:
+        return self.x.size
+
+    def dense(self, band: np.ndarray) -> np.ndarray:
+        """The band as a dense matrix (for checks)."""
+        n, w = self.size, self.half_width
+        out = np.zeros((n, n))
+        for i in range(n):
+            for j in range(max(0, i - w), min(n, i + w + 1)):
+                out[i, j] = band[i, j - i + w]
+        return out
+
+
+def _band(matrix, order: np.ndarray, half_width: int) -> np.ndarray:
+    coo = matrix[order][:, order].tocoo()
+    kept = coo.data != 0.0  # the assembled pattern stores the fields' couplings that vanish here as zeros
+    band = np.zeros((order.size, 2 * half_width + 1))
+    np.add.at(band, (coo.row[kept], coo.col[kept] - coo.row[kept] + half_width), coo.data[kept])
+    return band
+
+
+def axial_torsional_string(scene) -> AxialTorsionalString:
+    """The scene's string with only u and theta_x (module doc); the scene's ``model.lateral_length`` is taken as 0."""
+    scene = scene.with_changes(model={"lateral_length": 0.0})
+    disc = BeamDiscretization.from_scene(scene)
+    operators = assemble_linear(disc)
+    dofs = np.concatenate([disc.field_dofs[U], disc.field_dofs[THETA_X]])
+    x = disc.dof_coordinates[dofs]
+    angle = np.concatenate([np.zeros(disc.field_dofs[U].size, bool), np.ones(disc.field_dofs[THETA_X].size, bool)])
+    order = np.lexsort((angle, x))
+    dofs, x, angle = dofs[order], x[order], angle[order]
+    position = np.full(disc.ndofs, -1)
+    position[dofs] = np.arange(dofs.size)
+    pattern = (abs(operators.mass) + abs(operators.damping) + abs(operators.stiffness))[dofs][:, dofs].tocoo()
+    pattern.eliminate_zeros()
+    half_width = int(np.max(np.abs(pattern.row - pattern.col)))
+    vertex = np.stack([position[disc.vertex_dofs(U)], position[disc.vertex_dofs(THETA_X)]], axis=1)
+    contact_radius, _ = disc.vertex_radii(scene.borehole.radius)
+    cells = disc.element_properties  # one value, or one per element along x (a string of sections)
+    polar = float(np.atleast_1d(cells.polar_inertia_per_length)[0])
+    wave = math.sqrt(float(np.atleast_1d(cells.torsional_rigidity)[0]) / polar)
+    axial = float(np.max(np.sqrt(cells.young_modulus * np.atleast_1d(cells.stiffness_section.area)
+                                 / (cells.density * np.atleast_1d(cells.section.area)))))
+    return AxialTorsionalString(
+        x=x, angle=angle, half_width=half_width, mass=_band(operators.mass, dofs, half_width),
+        damping=_band(operators.damping, dofs, half_width), stiffness=_band(operators.stiffness, dofs, half_width),
+        gravity=operators.gravity[dofs],
+        top=(int(position[disc.end_dof(U, 0)]), int(position[disc.end_dof(THETA_X, 0)])),
+        bit=(int(position[disc.end_dof(U, 1)]), int(position[disc.end_dof(THETA_X, 1)])),
+        wall_dofs=vertex, wall_normal=np.abs(vertex_normal_forces(scene, disc)) if scene.model.contact
+        else np.zeros(len(disc.vertex_x)), wall_arm=np.asarray(contact_radius, float),
+        polar_inertia_at_top=polar, torsional_wave_speed_at_top=wave, axial_wave_speed=axial,
+        length=float(disc.properties.length))

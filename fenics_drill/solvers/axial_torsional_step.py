@@ -1,0 +1,284 @@
+"""Newmark steps of the axial-torsional string in one compiled call, with no Python per step.
+
+The string is :class:`~fenics_drill.model.axial_torsional_string.AxialTorsionalString`: M, C, K in one band. Each
+step solves M a + C v + K q = F_G + F_wall(q) + F_bit(q, v) + F_drive(q, v) at t + dt by Newton, with Newmark's
+(gamma, beta) = (1/2 + alpha, (1 + alpha)^2 / 4) (alpha = ``time.newmark_alpha``); the tangent K + c_v C + c_a M
+less the laws' derivatives is factorised in its band (LU without pivoting: c_a M dominates it) at every iterate.
+
+* **Wall**: at each vertex the Coulomb force at the contact point by return mapping
+  (:func:`~fenics_drill.model.forces.wall.coulomb._return_map`, the FE wall's law), its slip (du, R d theta_x)
+  since the step's start and its stuck spring k_t.
+* **Bit**: the paper's law (20)-(22) (:data:`~fenics_drill.model.forces.bit_rock.LAW`) or the cutting law
+  (:func:`~fenics_drill.model.forces.cutting_bit.cutting_law`) over the bottom surface one blade passage behind,
+  kept here as the accepted steps' (angle, surface) where the bit turned further than ever before.
+* **Drive**: u(0) held at V0 t or pushed with a constant force (hook load); theta_x(0) held at Omega t, or a top
+  drive of inertia J on it turned by a PI motor torque k_p (Omega - theta_dot) + k_i z, limited to T_max, its
+  integral z frozen while at the limit (:mod:`~fenics_drill.model.top_drive`).
+
+The algorithmic damping ratio of Newmark's scheme at a mode of circular frequency omega is about alpha omega dt / 2
+for omega dt << 1 (Hughes 2000, Sec. 9.3): at the first torsional modes of a long string (omega dt ~ 1e-3) it
+is far below the physics' damping, so a weak stick-slip instability is not damped away.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from fenics_drill.model.forces.bit_rock import LAW as PAPER_LAW
+from fenics_drill.model.forces.cutting_bit import cutting_law, surface_at
+from fenics_drill.model.forces.wall.coulomb import _return_map
+from fenics_drill.model.kernels.compiled import kernel
+
+#: The bit laws: none, the paper's (20)-(22), the cutting law.
+NO_BIT, PAPER, CUTTING = 0, 1, 2
+#: The columns of a record row.
+RECORDED = ("time", "bit_velocity", "bit_angular_velocity", "bit_force", "bit_torque", "top_velocity",
+            "top_angular_velocity", "top_force", "top_torque", "depth_of_cut", "vertices_stuck_on_the_wall")
+#: What :func:`advance` returns on failure: the step whose Newton did not converge.
+CONVERGED, NOT_CONVERGED = 0, 1
+
+
+@njit(cache=True)
+def band_matvec(band, w, x):
+    n = x.size
+    out = np.zeros(n)
+    for i in range(n):
+        s = 0.0
+        for j in range(max(0, i - w), min(n, i + w + 1)):
+            s += band[i, j - i + w] * x[j]
+        out[i] = s
+    return out
+
+
+@njit(cache=True)
+def band_solve(band, w, rhs):
+    """x of band x = rhs by Gaussian elimination without pivoting; ``band`` is overwritten by its LU."""
+    n = rhs.size
+    x = rhs.copy()
+    for k in range(n):
+        pivot = band[k, w]
+        for i in range(k + 1, min(n, k + w + 1)):
+            factor = band[i, k - i + w] / pivot
+            if factor == 0.0:
+                continue
+            band[i, k - i + w] = factor
+            for j in range(k + 1, min(n, k + w + 1)):
+                band[i, j - i + w] -= factor * band[k, j - k + w]
+            x[i] -= factor * x[k]
+    for i in range(n - 1, -1, -1):
+        s = x[i]
+        for j in range(i + 1, min(n, i + w + 1)):
+            s -= band[i, j - i + w] * x[j]
+        x[i] = s / band[i, w]
+    return x
+
+
+@njit(cache=True)
+def _wall(q, wall_dofs, normal, arm, friction, stick_stiffness, anchor, held, residual, tangent, w):
+    """The wall's Coulomb forces at every vertex: subtracted from ``residual``, their derivatives from
+    ``tangent``; ``held`` becomes the forces.  Returns how many vertices stick."""
+    stuck = 0
+    for k in range(normal.size):
+        iu, it = wall_dofs[k, 0], wall_dofs[k, 1]
+        r = arm[k]
+        cap = friction * abs(normal[k])
+        if cap == 0.0:  # off the wall: no friction
+            held[k, 0], held[k, 1] = 0.0, 0.0
+            continue
+        g_a, g_t = q[iu] - anchor[k, 0], r * (q[it] - anchor[k, 1])
+        f_a, f_t, size = _return_map(normal[k], held[k, 0], held[k, 1], g_a, g_t, friction, stick_stiffness)
+        residual[iu] -= f_a
+        residual[it] -= r * f_t
+        kt = stick_stiffness
+        if size <= cap:
+            aa, at, tt = -kt, 0.0, -kt
+            stuck += 1
+        else:  # on the cone: F = cap e, e = F* / |F*|, dF/dg = -k_t cap (I - e e^T) / |F*|
+            e_a, e_t = f_a / cap, f_t / cap
+            shrink = cap / size
+            aa, at, tt = -kt * shrink * (1.0 - e_a * e_a), kt * shrink * e_a * e_t, -kt * shrink * (1.0 - e_t * e_t)
+        tangent[iu, w] -= aa
+        tangent[iu, it - iu + w] -= at * r
+        tangent[it, iu - it + w] -= at * r
+        tangent[it, w] -= tt * r * r
+        held[k, 0], held[k, 1] = f_a, f_t
+    return stuck
+
+
+@njit(cache=True)
+def _previous_pass(surface, count, pruned, feed, passage, angle):
+    return surface_at(surface[0, :count], surface[1, :count], pruned, feed, angle - passage)
+
+
+@njit(cache=True)
+def _residual(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind, bit_law,
+              drive, gamma, c_a, c_v, h, q, q_pred, v_pred, x, anchor, held, trial_held, surface, surface_state,
+              tangent):
+    """The residual of the step to x (the drive's held rows zero), with its tangent written into ``tangent`` and
+    the wall's forces into ``trial_held``; and what is recorded of it: (residual, bit force, bit torque, depth of
+    cut, stuck vertices, top force, top torque, z)."""
+    acc = (x - q_pred) * c_a
+    vel = v_pred + gamma * h * acc
+    residual = band_matvec(mass, w, acc) + band_matvec(damping, w, vel) + band_matvec(stiffness, w, x) - gravity
+    tangent[:, :] = stiffness + c_v * damping + c_a * mass
+    trial_held[:, :] = held
+    stuck = _wall(x, wall_dofs, normal, arm, wall_law[0], wall_law[1], anchor, trial_held, residual, tangent, w)
+    tu, tt = top
+    bu, bt = bit
+    bit_force = bit_torque = depth = 0.0
+    if bit_kind == PAPER:
+        bit_force, bit_torque, d_force, d_torque_v, d_torque_w = PAPER_LAW(vel[bu], vel[bt], bit_law[0],
+                                                                           bit_law[1], bit_law[2], bit_law[3])
+        tangent[bu, w] -= c_v * d_force
+        tangent[bt, bu - bt + w] -= c_v * d_torque_v
+        tangent[bt, w] -= c_v * d_torque_w
+    elif bit_kind == CUTTING:
+        cut, slope = _previous_pass(surface, int(surface_state[0]), surface_state[1] > 0.5, surface_state[2],
+                                    bit_law[8], x[bt])
+        law = cutting_law(x[bu], vel[bu], vel[bt], cut, slope, bit_law[0], bit_law[1], bit_law[2], bit_law[3],
+                          bit_law[4], bit_law[5], bit_law[6], bit_law[7])
+        depth, bit_force, bit_torque = law[0], law[1], law[2]
+        tangent[bu, w] -= law[3] + c_v * law[7]
+        tangent[bu, bt - bu + w] -= law[4]
+        tangent[bt, bu - bt + w] -= law[5] + c_v * law[8]
+        tangent[bt, w] -= law[6] + c_v * law[9]
+    residual[bu] -= bit_force
+    residual[bt] -= bit_torque
+    top_force, top_torque, z = residual[tu], residual[tt], drive[8]  # what holding the top takes
+    if drive[0] > 0.5:
+        residual[tu] = 0.0
+        tangent[tu, :] = 0.0
+        tangent[tu, w] = 1.0
+    else:
+        top_force = drive[2]
+        residual[tu] -= top_force
+    if drive[3] > 0.5:
+        residual[tt] = 0.0
+        tangent[tt, :] = 0.0
+        tangent[tt, w] = 1.0
+    else:  # z = z_n + int (Omega - theta_dot) dt over the step, frozen at the motor's limit
+        omega, k_p, k_i, t_max = drive[4], drive[5], drive[6], drive[7]
+        z = drive[8] + omega * h - (x[tt] - q[tt])
+        top_torque = k_p * (omega - vel[tt]) + k_i * z
+        if abs(top_torque) > t_max:
+            top_torque, z = math.copysign(t_max, top_torque), drive[8]
+        else:
+            tangent[tt, w] += k_p * c_v + k_i
+        residual[tt] -= top_torque
+    return residual, bit_force, bit_torque, depth, stuck, top_force, top_torque, z
+
+
+@njit(cache=True)
+def _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind, bit_law,
+             drive, h, newmark, tolerance, max_iterations, q, v, a, t, anchor, held, trial_held, surface,
+             surface_state, tangent):
+    """One Newmark step of ``h`` from (q, v, a) at t by Newton, an update halved while it does not reduce the
+    residual (at most :data:`BACKTRACKS` times).  Returns (converged, x, recorded values of :func:`_residual`)."""
+    gamma, beta = newmark
+    c_a = 1.0 / (beta * h * h)
+    c_v = gamma / (beta * h)
+    q_pred = q + h * v + h * h * (0.5 - beta) * a
+    v_pred = v + h * (1.0 - gamma) * a
+    x = q + h * v + 0.5 * h * h * a
+    if drive[0] > 0.5:
+        x[top[0]] = drive[1] * (t + h)
+    if drive[3] > 0.5:
+        x[top[1]] = drive[4] * (t + h)
+    scale = max(np.max(np.abs(gravity)) * q.size, abs(drive[2]), 1.0)
+    ev = _residual(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind,
+                   bit_law, drive, gamma, c_a, c_v, h, q, q_pred, v_pred, x, anchor, held, trial_held, surface,
+                   surface_state, tangent)
+    norm = np.max(np.abs(ev[0]))
+    for iteration in range(max_iterations):
+        dx = band_solve(tangent, w, -ev[0])
+        cut = 1.0
+        for _ in range(BACKTRACKS + 1):
+            trial = x + cut * dx
+            trial_ev = _residual(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law,
+                                 bit_kind, bit_law, drive, gamma, c_a, c_v, h, q, q_pred, v_pred, trial, anchor,
+                                 held, trial_held, surface, surface_state, tangent)
+            trial_norm = np.max(np.abs(trial_ev[0]))
+            if trial_norm < norm or trial_norm <= tolerance * scale:
+                break
+            cut *= 0.5
+        x, ev, norm = trial, trial_ev, trial_norm
+        if norm <= tolerance * scale:
+            return True, x, ev
+    return False, x, ev
+
+
+#: Halvings of a Newton update that does not reduce the residual; halvings of a step that does not converge.
+BACKTRACKS, SUBSTEP_HALVINGS = 4, 10
+
+
+@kernel
+def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind, bit_law,
+            drive, dt, newmark, tolerance, max_iterations, steps, stride, q, v, a, clock, anchor, held, surface,
+            surface_state, records):
+    """Take ``steps`` steps of ``dt`` from the state (q, v, a) at ``clock[0]`` (all updated in place) and write a
+    row of :data:`RECORDED` into ``records`` every ``stride`` steps.  A step whose Newton does not converge is
+    taken in halves (down to dt / 2^:data:`SUBSTEP_HALVINGS`).  Returns (status, rows written).
+
+    ``wall_law``: (friction, stick stiffness); ``bit_law``: the law's constants (:data:`PAPER`: Gamma, alpha,
+    mu, R; :data:`CUTTING`: :attr:`CuttingBit.law_constants` then the blade passage); ``drive``: (axial held,
+    V0, top force, rotation held, Omega, k_p, k_i, T_max, z); ``anchor``, ``held``: each vertex's (u, theta_x)
+    and (F_a, F_t) at the last step; ``surface``: (2, capacity) angles and surfaces of the cut bottom with
+    ``surface_state`` = (count, pruned, feed per radian)."""
+    gamma = newmark[0]
+    bu, bt = bit
+    tangent = np.empty_like(mass)
+    trial_held = held.copy()
+    rows = 0
+    for step in range(steps):
+        remaining, h = dt, dt
+        while remaining > 1e-9 * dt:
+            h = min(h, remaining)
+            ok, x, ev = _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law,
+                                 bit_kind, bit_law, drive, h, newmark, tolerance, max_iterations, q, v, a, clock[0],
+                                 anchor, held, trial_held, surface, surface_state, tangent)
+            if not ok:
+                h *= 0.5
+                if h < dt / 2.0**SUBSTEP_HALVINGS:
+                    return NOT_CONVERGED, rows
+                continue
+            c_a = 1.0 / (newmark[1] * h * h)
+            acc = (x - (q + h * v + h * h * (0.5 - newmark[1]) * a)) * c_a
+            v[:] = v + h * (1.0 - gamma) * a + gamma * h * acc
+            a[:] = acc
+            if bit_kind == CUTTING:
+                _advance_surface(surface, surface_state, bit_law[8], x[bu], x[bt])
+            q[:] = x
+            anchor[:, 0] = x[wall_dofs[:, 0]]
+            anchor[:, 1] = x[wall_dofs[:, 1]]
+            held[:, :] = trial_held
+            drive[8] = ev[7]
+            clock[0] += h
+            remaining -= h
+        if (step + 1) % stride == 0 and rows < records.shape[0]:
+            row = records[rows]
+            row[0], row[1], row[2], row[3], row[4] = clock[0], v[bu], v[bt], ev[1], ev[2]
+            row[5], row[6], row[7], row[8] = v[top[0]], v[top[1]], ev[5], ev[6]
+            row[9], row[10] = ev[3], ev[4]
+            rows += 1
+    return CONVERGED, rows
+
+
+@njit(cache=True)
+def _advance_surface(surface, surface_state, passage, position, angle):
+    """Record an accepted bit state (:meth:`~fenics_drill.model.forces.cutting_bit.CutSurface.advance`): where the
+    bit turned further than ever, the blade at ``angle`` leaves max(position, the surface it met); entries more
+    than two revolutions behind are dropped when the storage is full."""
+    count = int(surface_state[0])
+    if angle <= surface[0, count - 1]:
+        return
+    if count == surface.shape[1]:
+        keep = max(1, np.searchsorted(surface[0, :count], angle - 4.0 * math.pi) - 1)
+        surface[:, :count - keep] = surface[:, keep:count].copy()
+        count -= keep
+        surface_state[1] = 1.0
+    cut = _previous_pass(surface, count, surface_state[1] > 0.5, surface_state[2], passage, angle)[0]
+    surface[0, count], surface[1, count] = angle, max(position, cut)
+    surface_state[0] = count + 1
