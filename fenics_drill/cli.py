@@ -314,6 +314,37 @@ def _risk(scene, args) -> int:
     return 0
 
 
+def cmd_stick_slip_map(args) -> int:
+    """Stick-slip over weight on bit x rotation speed on the scene's axial-torsional string (MPI-parallel,
+    resumable): DIR/map.nc, map.csv, map.json, stick_slip_map.png."""
+    from mpi4py import MPI
+
+    from fenics_drill.plots.directory import plot_directory
+    from fenics_drill.studies.stick_slip_map import write_stick_slip_map
+
+    scene = load_scene(args.scene, args.overrides)
+    study = write_stick_slip_map(scene, args.out, resume=args.resume, overwrite=args.overwrite,
+                                 progress=not args.quiet)
+    if MPI.COMM_WORLD.rank > 0 or study is None:
+        return 0
+    _drawn(lambda: plot_directory(Path(args.out)))
+    report, grid = study["report"], study["map"]
+    print(f"{report['points']} points on {report['ranks']} rank(s), {report['settled_points']} settled "
+          f"[{report['wall_time_s']:.1f} s] -> {Path(args.out) / 'map.json'}")
+    for controller in grid.controller.values:
+        at = grid.sel(controller=controller)
+        print(f"  {controller}: stick-slip severity by weight on bit (rows, kN) and rotation speed (columns, rpm)")
+        print("           " + "".join(f"{o * 30 / np.pi:8.0f}" for o in at.rotation_speed.values))
+        for i, w in enumerate(at.weight_on_bit.values):
+            cells = [("   fail " if not np.isfinite(v) else f"{v:7.2f}" + ("*" if not s else " "))
+                     for v, s in zip(at.severity.values[i], at.settled.values[i])]
+            print(f"  {w / 1e3:8.1f} " + "".join(cells))
+    if report["settled_points"] < report["points"]:
+        print(f"  *: not settled within stick_slip_map.time_limit = {grid.attrs['time_limit_s']:g} s (its last "
+              "windows reported)")
+    return 0
+
+
 def cmd_broomstick(args) -> int:
     """The broomstick chart of the scene's well: DIR/broomstick.nc, broomstick.csv, broomstick.json, broomstick.png."""
     from fenics_drill.plots.directory import plot_directory
@@ -406,6 +437,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true", help="with --samples: continue the study in --out")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_torque_drag)
+    p = sub.add_parser("stick-slip-map", help="stick-slip severity, period, stuck share, rop and specific energy "
+                                              "over weight on bit x rotation speed on the axial-torsional string "
+                                              "(MPI-parallel, resumable): DIR/map.nc, map.csv, map.json")
+    _scene_args(p)
+    p.add_argument("--resume", action="store_true", help="continue in --out, skipping the points done")
+    p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.set_defaults(func=cmd_stick_slip_map)
     p = sub.add_parser("broomstick", help="hook load and surface torque against bit depth for the chart's operations "
                                           "and friction factors, with the rig's limits: DIR/broomstick.nc, .csv, .png")
     _scene_args(p)

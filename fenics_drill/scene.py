@@ -548,6 +548,28 @@ class Risk:
                     ">= 0")
 
 
+def _controllers(x) -> bool:
+    return len(x) >= 1 and len(set(x)) == len(x) and all(c in _CONTROLLERS for c in x)
+
+
+_CONTROLLERS = ("stiff", "pi", "soft_torque")
+
+
+@dataclass(frozen=True)
+class StickSlipMap:
+    """Stick-slip over weight on bit x rotation speed (``fenics-drill stick-slip-map``): each point the scene's
+    axial-torsional string run to its limit cycle or steady rotation, or to ``time_limit``."""
+
+    weight_on_bit: tuple = key((20e3, 80e3, 4), "grid of the weight on bit: [min, max, points] [N]", _grid_axis, _GRID)
+    rotation_speed: tuple = key((2.0 * math.pi, 8.0 * math.pi, 4), "grid of the rotation speed: [min, max, points] "
+                                "[rad/s]", _grid_axis, _GRID)
+    controllers: tuple = key(("stiff",), "the rotary drives mapped (drive.controller's choices)", _controllers,
+                             "a non-empty list of distinct names among " + ", ".join(_CONTROLLERS))
+    time_limit: float = _pos("longest drilling time run at a point before its cycle has settled [s]", 200.0)
+    element_length: float = _pos("the axial-torsional string's element length (beam.elements is the lateral "
+                                 "fields') [m]", 10.0)
+
+
 @dataclass(frozen=True)
 class Scene:
     """A validated scene: one typed, immutable section per TOML table."""
@@ -574,6 +596,7 @@ class Scene:
     torque_drag: TorqueDrag = field(default_factory=TorqueDrag)
     broomstick: Broomstick = field(default_factory=Broomstick)
     risk: Risk = field(default_factory=Risk)
+    stick_slip_map: StickSlipMap = field(default_factory=StickSlipMap)
 
     def to_dict(self) -> dict[str, dict[str, Any]]:
         """The scene as nested plain values (what summary files and study directories store)."""

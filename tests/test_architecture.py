@@ -66,6 +66,7 @@ MODEL_PARTS = {
     "fenics_drill.model.survey_errors": 1,
     "fenics_drill.model.reduction": 2,
     "fenics_drill.model.drillstring": 3,
+    "fenics_drill.model.axial_torsional_string": 3,
     "fenics_drill.model.rotating_modes": 3,
 }
 

@@ -64,16 +64,19 @@ OWNED = {
                    FIGURE_RECORD),
     "calibrate": ("summary.json", "calibration.json", "broomstick.nc", "calibrated.nc", "calibration.png",
                   "friction_track.png", FIGURE_RECORD),
+    "stick-slip-map": ("summary.json", "scene.json", "points", "map.json", "map.nc", "map.csv", "stick_slip_map.png",
+                       FIGURE_RECORD),
 }
 #: A temporary file of an atomic write (:func:`fenics_drill.io.files.temporary_path`): ``.NAME.tmpPID``.
 TEMPORARY = re.compile(r"^\.(?P<name>.+)\.tmp\d+$")
 SIGNATURE = {"run": "timeseries.h5", "static": "static.json", "modal": "modes.json", "campbell": "campbell.json",
              "mc": "realisations", "optimize": "points",
-             "torque-drag": "torque_drag.json", "broomstick": "broomstick.json", "calibrate": "calibration.json"}
+             "torque-drag": "torque_drag.json", "broomstick": "broomstick.json", "calibrate": "calibration.json",
+             "stick-slip-map": "map.json"}
 DESCRIPTION = {"run": "a drilling run", "static": "a static equilibrium", "modal": "a modal analysis",
                "campbell": "a Campbell diagram", "mc": "a Monte Carlo study", "optimize": "an operating-window study",
                "torque-drag": "a torque-and-drag study", "broomstick": "a broomstick chart",
-               "calibrate": "a friction calibration"}
+               "calibrate": "a friction calibration", "stick-slip-map": "a stick-slip map"}
 
 
 class OutputError(ValueError):

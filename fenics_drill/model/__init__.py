@@ -11,5 +11,6 @@ Three concerns, from the bottom up (``tests/test_architecture.py`` holds them to
 - :mod:`~fenics_drill.model.reduction`: modes, solution spaces, the basis guard, hyper-reduction;
 
 and on top of them :mod:`~fenics_drill.model.drillstring` (the assembled model: residual, tangent, drive
-constraints) and :mod:`~fenics_drill.model.rotating_modes` (the string linearised about a steady spin).
+constraints), :mod:`~fenics_drill.model.rotating_modes` (the string linearised about a steady spin) and
+:mod:`~fenics_drill.model.axial_torsional_string` (the string's u and theta_x alone, one band for stick-slip).
 """

@@ -12,7 +12,7 @@ vertex_normal_forces`), and the top drive's inertia sits on theta_x(0) where a c
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -57,6 +57,18 @@ class AxialTorsionalString:
         return out
 
 
+def wall_normal_forces(scene, vertex_x: np.ndarray) -> np.ndarray:
+    """|N_i| [N] at each vertex for the scene's operation (none without ``model.contact``)."""
+    if not scene.model.contact:
+        return np.zeros(len(vertex_x))
+    return np.abs(vertex_normal_forces(scene, vertex_x))
+
+
+def pressed_for(string: AxialTorsionalString, scene) -> AxialTorsionalString:
+    """The same string pressed on the wall as ``scene``'s operation presses it (another weight on bit)."""
+    return replace(string, wall_normal=wall_normal_forces(scene, string.x[string.wall_dofs[:, 0]]))
+
+
 def _band(matrix, order: np.ndarray, half_width: int) -> np.ndarray:
     coo = matrix[order][:, order].tocoo()
     kept = coo.data != 0.0  # the assembled pattern stores the fields' couplings that vanish here as zeros
@@ -93,7 +105,6 @@ def axial_torsional_string(scene) -> AxialTorsionalString:
         gravity=operators.gravity[dofs],
         top=(int(position[disc.end_dof(U, 0)]), int(position[disc.end_dof(THETA_X, 0)])),
         bit=(int(position[disc.end_dof(U, 1)]), int(position[disc.end_dof(THETA_X, 1)])),
-        wall_dofs=vertex, wall_normal=np.abs(vertex_normal_forces(scene, disc)) if scene.model.contact
-        else np.zeros(len(disc.vertex_x)), wall_arm=np.asarray(contact_radius, float),
+        wall_dofs=vertex, wall_normal=wall_normal_forces(scene, disc.vertex_x), wall_arm=np.asarray(contact_radius, float),
         polar_inertia_at_top=polar, torsional_wave_speed_at_top=wave, axial_wave_speed=axial,
         length=float(disc.properties.length))

@@ -49,7 +49,8 @@ def drawn_from(directory: Path) -> dict:
     except (UnreadableFile, OSError):
         summary = {}
     status = summary.get("status", "unknown")
-    for kind, name in (("calibrate", "calibration.json"), ("broomstick", "broomstick.json"), ("risk", "risk.json"),
+    for kind, name in (("stick-slip-map", "map.json"), ("calibrate", "calibration.json"),
+                       ("broomstick", "broomstick.json"), ("risk", "risk.json"),
                        ("torque-drag", "torque_drag.json"), ("campbell", "campbell.json"), ("modal", "modes.json"),
                        ("optimize", "optimize.json"), ("mc", "statistics.h5"),
                        ("run", "timeseries.h5"), ("static", "static_profiles.h5")):
@@ -62,7 +63,8 @@ def drawn_from(directory: Path) -> dict:
                             "modal'), campbell.json "
                             "('fenics-drill campbell'), torque_drag.json or risk.json ('fenics-drill torque-drag'), "
                             "broomstick.json "
-                            "('fenics-drill broomstick'), calibration.json ('fenics-drill calibrate') or "
+                            "('fenics-drill broomstick'), map.json ('fenics-drill stick-slip-map'), "
+                            "calibration.json ('fenics-drill calibrate') or "
                             f"static_profiles.h5 ('fenics-drill static' on a well){said}")
     state = {"kind": kind, "status": status}
     if kind == "run":
@@ -86,6 +88,10 @@ def drawn_from(directory: Path) -> dict:
 
 
 def _draw(directory: Path, kind: str, gif: bool) -> list[Path]:
+    if kind == "stick-slip-map":
+        from fenics_drill.plots.stick_slip_map import stick_slip_map_figures
+
+        return stick_slip_map_figures(directory)
     if kind == "risk":
         from fenics_drill.plots.risk import risk_figures
 

@@ -205,13 +205,16 @@ def _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, 
                 break
             cut *= 0.5
         x, ev, norm = trial, trial_ev, trial_norm
-        if norm <= tolerance * scale:
+        if norm <= tolerance * scale or np.max(np.abs(cut * dx)) <= ROUND_OFF * (np.max(np.abs(x)) + 1.0):
             return True, x, ev
     return False, x, ev
 
 
 #: Halvings of a Newton update that does not reduce the residual; halvings of a step that does not converge.
 BACKTRACKS, SUBSTEP_HALVINGS = 4, 10
+#: An update below this share of the state's largest entry is round-off: the iterate has converged (at small steps
+#: the residual's inertia, (x - x_pred) / (beta dt^2), carries the state's round-off magnified by 1 / dt^2).
+ROUND_OFF = 1e-14
 
 
 @kernel

@@ -3,10 +3,12 @@
 :func:`start` sets the string of :mod:`~fenics_drill.model.axial_torsional_string` at the scene's start (its static
 state on bottom at ``drive.weight_on_bit``, or hanging off bottom, moving at the drive's V0 and Omega) for the
 compiled steps of :mod:`~fenics_drill.solvers.axial_torsional_step`.  :func:`limit_cycle` steps it window by window
-(each two of the string's first torsional periods 4 L / c_T, held at the top and free at the bit) until the bit's
-spin repeats over the last :data:`SETTLED_WINDOWS` windows (its extremes within :data:`SPIN_TOLERANCE` of the
-drive's speed, its stuck share within :data:`SHARE_TOLERANCE`, the mean surface torque within
-:data:`TORQUE_TOLERANCE`), or until a time limit, and reports the cycle over those windows (:func:`cycle_metrics`).
+(each two of the string's first torsional periods 4 L / c_T, held at the top and free at the bit) until, past the
+start's transient, the bit's spin stays within :data:`SPIN_TOLERANCE` of the drive's speed (steady rotation), or its
+last :data:`SETTLED_CYCLES` cycles (from one rise of the spin through the drive's speed to the next) repeat: their
+fastest and slowest spin within :data:`SPIN_TOLERANCE` of the drive's speed, their stuck shares within
+:data:`SHARE_TOLERANCE`, their mean surface torques within :data:`TORQUE_TOLERANCE` and their durations within
+:data:`PERIOD_TOLERANCE`.  Or until a time limit; the report says which (:func:`cycle_metrics`).
 
 Signs: ``top_force`` is the force the drive applies to the top along the string (down-hole), so the hook load is
 its negative; ``top_torque`` is the torque it applies (positive while it turns the string); ``bit_force`` and
@@ -31,11 +33,13 @@ from fenics_drill.solvers.newmark import newmark_parameters
 
 #: A bit turning slower than this share of the drive's speed is stuck.
 STUCK_SHARE = 0.01
-#: The windows over which a limit cycle must repeat, and how closely.
-SETTLED_WINDOWS = 3
+#: The cycles over which a limit cycle must repeat, and how closely; the windows (two first torsional periods
+#: each) taken as the start's transient, and those searched for repeating cycles.
+SETTLED_CYCLES, TRANSIENT_WINDOWS, HISTORY_WINDOWS = 3, 2, 8
 SPIN_TOLERANCE = 0.02  # of the drive's speed, for the bit's fastest and slowest spin
 SHARE_TOLERANCE = 0.02  # of the time, for the stuck share
-TORQUE_TOLERANCE = 0.01  # of the mean surface torque
+TORQUE_TOLERANCE = 0.02  # of the mean surface torque
+PERIOD_TOLERANCE = 0.02  # of the cycle's duration
 #: Newton's stop (the residual's largest entry against the string's weight) and its iterations per step.
 TOLERANCE, MAX_ITERATIONS = 1e-10, 40
 #: The cut bottom's memory: (angle, surface) entries kept (more than two revolutions of accepted steps).
@@ -90,8 +94,9 @@ def first_torsional_period(string: AxialTorsionalString) -> float:
 
 
 def default_step(string: AxialTorsionalString) -> float:
-    """The shortest element's axial wave transit time h / c_L [s] (``time.dt = -1``)."""
-    return float(np.min(np.diff(string.x[string.wall_dofs[:, 0]])) / string.axial_wave_speed)
+    """The mean element's axial wave transit time, (L / elements) / c_L [s] (``time.dt = -1``): short elements
+    (a stabiliser's 2 m) do not set it, for the scheme is implicit (its accuracy is measured in docs/performance.md)."""
+    return float(string.length / (len(string.wall_dofs) - 1) / string.axial_wave_speed)
 
 
 def _bit_law(scene, string: AxialTorsionalString) -> tuple[int, np.ndarray]:
@@ -167,7 +172,7 @@ def _top_section(string: AxialTorsionalString) -> _TopSection:
 
 
 def window_metrics(series: dict, rotation_speed: float) -> dict:
-    """The bit's spin and the drive's loads over recorded rows."""
+    """The bit's spin and the drive's loads over recorded rows (means in time)."""
     t = series["time"]
     spin = series["bit_angular_velocity"]
     span = t[-1] - t[0] if t.size > 1 else 1.0
@@ -176,51 +181,69 @@ def window_metrics(series: dict, rotation_speed: float) -> dict:
         return float(np.trapezoid(values, t) / span) if t.size > 1 else float(values[-1])
 
     return {"max_spin": float(spin.max()), "min_spin": float(spin.min()), "mean_spin": mean(spin),
-            "stuck_share": float(np.mean(spin < STUCK_SHARE * rotation_speed)),
+            "stuck_share": mean((spin < STUCK_SHARE * rotation_speed).astype(float)),
             "surface_torque": mean(series["top_torque"]), "hook_load": -mean(series["top_force"]),
             "weight_on_bit": -mean(series["bit_force"]), "bit_torque": -mean(series["bit_torque"]),
             "bit_power": -mean(series["bit_torque"] * spin), "rop": mean(series["bit_velocity"])}
 
 
-def settled(windows: list[dict], rotation_speed: float) -> bool:
-    """Whether the last :data:`SETTLED_WINDOWS` windows repeat one another (module doc), or the last turns
-    steadily (its spin within :data:`SPIN_TOLERANCE` of the drive's speed from end to end)."""
-    if windows and windows[-1]["max_spin"] - windows[-1]["min_spin"] <= SPIN_TOLERANCE * rotation_speed:
-        return True
-    if len(windows) < SETTLED_WINDOWS:
-        return False
-    last = windows[-SETTLED_WINDOWS:]
+def cycles(series: dict, rotation_speed: float) -> list[slice]:
+    """The rows of each whole cycle of the bit's spin: from one rise through the drive's speed to the next."""
+    above = series["bit_angular_velocity"] > rotation_speed
+    rising = np.flatnonzero(~above[:-1] & above[1:]) + 1
+    return [slice(a, b + 1) for a, b in zip(rising[:-1], rising[1:])]
 
+
+def _part(series: dict, rows: slice) -> dict:
+    return {name: values[rows] for name, values in series.items()}
+
+
+def repeating(parts: list[dict], rotation_speed: float) -> bool:
+    """Whether the metrics of ``parts`` (:func:`window_metrics` and a duration each) agree (module doc)."""
     def spread(key):
-        values = [w[key] for w in last]
+        values = [p[key] for p in parts]
         return max(values) - min(values)
 
-    torque = max(abs(w["surface_torque"]) for w in last)
+    torque = max(abs(p["surface_torque"]) for p in parts)
+    duration = max(p["duration"] for p in parts)
     return (spread("max_spin") <= SPIN_TOLERANCE * rotation_speed
             and spread("min_spin") <= SPIN_TOLERANCE * rotation_speed
             and spread("stuck_share") <= SHARE_TOLERANCE
-            and spread("surface_torque") <= TORQUE_TOLERANCE * max(torque, 1e-30))
+            and spread("surface_torque") <= TORQUE_TOLERANCE * max(torque, 1e-30)
+            and spread("duration") <= PERIOD_TOLERANCE * duration)
 
 
-def cycle_period(t: np.ndarray, spin: np.ndarray) -> float | None:
-    """The mean time between the bit's spin rising through its mean, or None with fewer than two such crossings."""
-    above = spin > spin.mean()
-    rising = np.flatnonzero(~above[:-1] & above[1:])
-    if rising.size < 2:
-        return None
-    return float((t[rising[-1]] - t[rising[0]]) / (rising.size - 1))
+def settled_cycle(series: dict, rotation_speed: float, after: float) -> tuple[str | None, dict | None]:
+    """('steady', rows) where the spin after ``after`` [s] stays within :data:`SPIN_TOLERANCE` of the drive's speed
+    over its last window; ('cycle', rows of the last :data:`SETTLED_CYCLES` cycles) where they repeat; else
+    (None, None)."""
+    t, spin = series["time"], series["bit_angular_velocity"]
+    late = t > after
+    if not np.any(late):
+        return None, None
+    if np.ptp(spin[late]) <= SPIN_TOLERANCE * rotation_speed:
+        return "steady", _part(series, late)
+    whole = [c for c in cycles(series, rotation_speed) if t[c][0] > after]
+    if len(whole) < SETTLED_CYCLES:
+        return None, None
+    last = whole[-SETTLED_CYCLES:]
+    parts = [dict(window_metrics(_part(series, c), rotation_speed), duration=float(np.ptp(t[c]))) for c in last]
+    if not repeating(parts, rotation_speed):
+        return None, None
+    return "cycle", _part(series, slice(last[0].start, last[-1].stop))
 
 
-def cycle_metrics(series: dict, rotation_speed: float, bit_area: float) -> dict:
-    """The cycle over ``series``: severity (max - min) / (2 mean) of the bit's spin, its period, the stuck share,
-    the means of the rop, the surface torque, the hook load and the weight on bit, and the mechanical specific
-    energy at the bit, W / A + <T omega> / (A rop) (Teale 1965, with the bit's torque and spin) [Pa]."""
+def cycle_metrics(series: dict, rotation_speed: float, bit_area: float, steady: bool) -> dict:
+    """The cycle over ``series``: severity (max - min) / (2 mean) of the bit's spin, its period (``series`` holds
+    whole cycles), the stuck share, the means of the rop, the surface torque, the hook load and the weight on bit,
+    and the mechanical specific energy at the bit, W / A + <T omega> / (A rop) (Teale 1965, with the bit's torque
+    and spin) [Pa]."""
     m = window_metrics(series, rotation_speed)
-    steady = m["max_spin"] - m["min_spin"] <= SPIN_TOLERANCE * rotation_speed
     mean_spin = m["mean_spin"]
+    rises = len(cycles(series, rotation_speed))
     return {
         "severity": float((m["max_spin"] - m["min_spin"]) / (2.0 * mean_spin)) if mean_spin > 0 else math.inf,
-        "period_s": None if steady else cycle_period(series["time"], series["bit_angular_velocity"]),
+        "period_s": None if steady or rises == 0 else float(np.ptp(series["time"]) / rises),
         "stuck_share": m["stuck_share"], "max_bit_spin_rad_s": m["max_spin"], "min_bit_spin_rad_s": m["min_spin"],
         "mean_bit_spin_rad_s": mean_spin, "rop_m_s": m["rop"], "surface_torque_N_m": m["surface_torque"],
         "hook_load_N": m["hook_load"], "weight_on_bit_N": m["weight_on_bit"], "bit_torque_N_m": m["bit_torque"],
@@ -237,23 +260,27 @@ def bit_area(scene) -> float:
 
 def limit_cycle(scene, time_limit: float, dt: float | None = None, simulation: Simulation | None = None,
                 progress=None) -> dict:
-    """Step the scene's string until its limit cycle or steady rotation has settled (module doc), or to
-    ``time_limit`` [s]: the cycle's metrics over the last windows, with ``settled``, the time run and the
-    windows' length."""
+    """Step the scene's string window by window (two first torsional periods each) until its steady rotation or
+    its limit cycle has settled after the first :data:`TRANSIENT_WINDOWS` windows (:func:`settled_cycle`), or to
+    ``time_limit`` [s]: the cycle's metrics (:func:`cycle_metrics`; at the limit, over the last
+    :data:`TRANSIENT_WINDOWS` windows), with ``settled``, the time run, the window and the step."""
     simulation = start(scene, dt=dt) if simulation is None else simulation
     window = 2.0 * first_torsional_period(simulation.string)
     omega = scene.drive.rotation_speed
-    windows, kept = [], []
+    kind, rows = None, None
     while simulation.time < time_limit - 1e-9:
-        rows = simulation.run(min(window, time_limit - simulation.time))
-        windows.append(window_metrics(rows, omega))
-        kept = (kept + [rows])[-SETTLED_WINDOWS:]
+        simulation.run(min(window, time_limit - simulation.time))
         if progress is not None:
             progress(simulation.time)
-        if simulation.time >= 2.0 * window and settled(windows, omega):
-            break
-    series = {name: np.concatenate([rows[name] for rows in kept]) for name in RECORDED}
-    out = cycle_metrics(series, omega, bit_area(scene))
-    out.update(settled=bool(settled(windows, omega)), time_s=simulation.time, window_s=window,
-               dt_s=simulation.dt)
+        if simulation.time >= TRANSIENT_WINDOWS * window:
+            series = simulation.series()
+            kind, rows = settled_cycle(series, omega, max(TRANSIENT_WINDOWS * window,
+                                                          simulation.time - HISTORY_WINDOWS * window))
+            if kind is not None:
+                break
+    if kind is None:
+        series = simulation.series()
+        rows = _part(series, series["time"] > series["time"][-1] - TRANSIENT_WINDOWS * window)
+    out = cycle_metrics(rows, omega, bit_area(scene), kind == "steady")
+    out.update(settled=kind is not None, time_s=simulation.time, window_s=window, dt_s=simulation.dt)
     return out

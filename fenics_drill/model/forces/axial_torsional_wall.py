@@ -39,20 +39,19 @@ class AxialTorsionalWallForces(ForceEvaluation):
     trial: np.ndarray = None
 
 
-def vertex_normal_forces(scene, disc: BeamDiscretization) -> np.ndarray:
-    """N_i [N] at every vertex: the soft string's wall force per length of the scene's operation (module doc),
-    integrated over the half elements beside each vertex."""
+def vertex_normal_forces(scene, x: np.ndarray) -> np.ndarray:
+    """N_i [N] at vertices ``x`` (measured depths along the string): the soft string's wall force per length of the
+    scene's operation (module doc), integrated over the half elements beside each vertex."""
     sections = string_sections(scene)
     g = scene.environment.gravity if scene.model.gravity else 0.0
     weights = np.array([s.buoyed_weight(g, scene.fluid.density, scene.inner_fluid_density) for s in sections])
     well = well_of(scene, sections[-1].bottom)  # the paper's straight horizontal hole without a survey
     mu = scene.contact.friction
-    mesh = string_mesh(well, sections, min(scene.torque_drag.element_length, float(np.diff(disc.vertex_x).min())),
+    mesh = string_mesh(well, sections, min(scene.torque_drag.element_length, float(np.diff(x).min())),
                        weights, mu, mu)
     name = "rotating_on_bottom" if scene.starts_on_bottom else "rotating_off_bottom"
     per_length = soft_string(mesh, operations(scene, [name])[0])["wall_force_per_length"]
     carried = np.concatenate([[0.0], np.cumsum(per_length * np.diff(mesh.md))])  # the wall's force above each node
-    x = disc.vertex_x
     middle = np.concatenate([[x[0]], 0.5 * (x[1:] + x[:-1]), [x[-1]]])
     return np.diff(np.interp(middle, mesh.md, carried))
 
@@ -85,7 +84,7 @@ class AxialTorsionalWall:
     @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "AxialTorsionalWall":
         contact_radius, _ = disc.vertex_radii(scene.borehole.radius)
-        return cls(disc, space, vertex_normal_forces(scene, disc), contact_radius, scene.contact.friction,
+        return cls(disc, space, vertex_normal_forces(scene, disc.vertex_x), contact_radius, scene.contact.friction,
                    scene.contact.stick_stiffness)
 
     def fresh(self) -> "AxialTorsionalWall":

@@ -1,0 +1,182 @@
+"""``fenics-drill stick-slip-map SCENE``: where stick-slip stops in weight on bit x rotation speed, for each rotary
+drive of ``stick_slip_map.controllers``, on the scene's axial-torsional string.
+
+Each point is the scene with ``drive.weight_on_bit``, ``drive.rotation_speed`` and ``drive.controller`` set to it,
+run by :func:`~fenics_drill.studies.stick_slip.limit_cycle` until its cycle has settled or to
+``stick_slip_map.time_limit``.  The points are shared over the MPI ranks, one file each in DIR/points (a resumed map
+skips those written); then DIR/map.nc (``controller`` x ``weight_on_bit`` x ``rotation_speed``), map.csv, map.json and
+summary.json.  Every point is checked before any is run: a weight on bit the drive cannot set refuses the map.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from fenics_drill.io.files import UnreadableFile, read_json, usable_result, write_atomic, write_json
+from fenics_drill.io.study_directory import all_done, claim, polled_barrier, stopped_rank
+from fenics_drill.model.axial_torsional_string import axial_torsional_string, pressed_for
+from fenics_drill.model.well import check_weight_on_bit
+from fenics_drill.scene import SceneError
+from fenics_drill.studies.lifecycle import scene_record, stop_if_requested, study_run
+from fenics_drill.studies.stick_slip import StepFailed, limit_cycle, start
+
+#: What each point reports, with its unit, in map.nc and map.csv.
+REPORTED = {"severity": "-", "period_s": "s", "stuck_share": "-", "max_bit_spin_rad_s": "rad/s",
+            "min_bit_spin_rad_s": "rad/s", "mean_bit_spin_rad_s": "rad/s", "rop_m_s": "m/s",
+            "surface_torque_N_m": "N m", "hook_load_N": "N", "weight_on_bit_N": "N", "bit_torque_N_m": "N m",
+            "mechanical_specific_energy_Pa": "Pa", "time_s": "s", "wall_time_s": "s"}
+
+
+def grid(axis: tuple) -> np.ndarray:
+    low, high, n = axis
+    return np.linspace(low, high, int(n))
+
+
+def map_scene(scene):
+    """The scene whose string the map steps: ``stick_slip_map.element_length`` sets its mesh."""
+    return scene.with_changes(beam={"elements": max(1, math.ceil(scene.string_length
+                                                                 / scene.stick_slip_map.element_length))})
+
+
+def map_points(scene) -> list[tuple[str, float, float]]:
+    """(controller, weight on bit, rotation speed) of every point, controller by controller."""
+    m = scene.stick_slip_map
+    return [(c, float(w), float(o)) for c in m.controllers for w in grid(m.weight_on_bit)
+            for o in grid(m.rotation_speed)]
+
+
+def point_scene(scene, controller: str, weight_on_bit: float, rotation_speed: float):
+    """The scene at one point of the map; SceneError naming the point where its drive cannot start there."""
+    try:
+        point = scene.with_changes(drive={"weight_on_bit": weight_on_bit, "rotation_speed": rotation_speed,
+                                          "controller": controller}, model={"lateral_length": 0.0})
+        check_weight_on_bit(point)
+    except SceneError as err:
+        raise SceneError(f"the stick-slip map's point (weight on bit {weight_on_bit:g} N, rotation speed "
+                         f"{rotation_speed:g} rad/s, {controller}) cannot start: {err}") from None
+    if rotation_speed <= 0.0:
+        raise SceneError("stick_slip_map.rotation_speed must be > 0 at every point (a map of a string that does not "
+                         "turn has no stick-slip); its minimum is 0")
+    if weight_on_bit <= 0.0 and scene.starts_on_bottom:
+        raise SceneError("stick_slip_map.weight_on_bit must be > 0 at every point of a map on bottom; its minimum is 0")
+    return point
+
+
+def _point_path(out: Path, index: int) -> Path:
+    return out / "points" / f"{index:06d}.json"
+
+
+def _read_point(path: Path) -> dict:
+    data = read_json(path)
+    if "severity" not in data:
+        raise UnreadableFile(f"{path} is not a whole result")
+    return data
+
+
+def run_point(scene, string, controller: str, weight_on_bit: float, rotation_speed: float) -> dict:
+    """One point's cycle (:func:`~fenics_drill.studies.stick_slip.limit_cycle`), with its wall time; a point whose
+    Newton fails reports it (``failed``) with NaN metrics rather than ending the map."""
+    clock = time.perf_counter()
+    point = point_scene(scene, controller, weight_on_bit, rotation_speed)
+    try:
+        out = limit_cycle(point, point.stick_slip_map.time_limit, simulation=start(point, string=pressed_for(string, point)))
+        out["failed"] = None
+    except StepFailed as err:
+        out = {name: float("nan") for name in REPORTED}
+        out.update(settled=False, steady_rotation=False, failed=str(err))
+    out["wall_time_s"] = time.perf_counter() - clock
+    return out
+
+
+def write_stick_slip_map(scene, out: str | Path, resume: bool = False, overwrite: bool = False,
+                         progress: bool = True, comm=None) -> dict | None:
+    """The map over the ranks of ``comm`` (MPI's world by default), module doc.  The first rank returns its
+    ``report`` and ``map`` (an ``xarray.Dataset``), the others None."""
+    from mpi4py import MPI
+
+    comm = MPI.COMM_WORLD if comm is None else comm
+    out = Path(out)
+    clock = time.perf_counter()
+    scene = map_scene(scene)
+    points = map_points(scene)
+    for controller, w, o in points:  # every point checked before the directory is taken
+        point_scene(scene, controller, w, o)
+    string = axial_torsional_string(scene)  # one band for every point; its wall pressed for each point's weight
+
+    def counts() -> dict:
+        return {"points": len(points), "points_done": len(list((out / "points").glob("*.json")))}
+
+    with claim(out, {"scene": scene.to_dict()}, "stick-slip-map", resume, overwrite, comm, counts), \
+            study_run(out, "stick-slip-map", comm, counts):
+        if comm.rank == 0:
+            (out / "points").mkdir(exist_ok=True)
+        polled_barrier(comm)
+        for index in range(comm.rank, len(points), comm.size):
+            stop_if_requested()
+            if (stop := stopped_rank(out, comm.rank)) is not None:
+                raise stop
+            path = _point_path(out, index)
+            if usable_result(path, _read_point):
+                continue
+            write_json(path, run_point(scene, string, *points[index]))
+            if progress and comm.rank == 0:
+                done = len(list((out / "points").glob("*.json")))
+                sys.stderr.write(f"\r  points {done:4d} / {len(points)}  wall {time.perf_counter() - clock:7.1f} s ")
+                sys.stderr.flush()
+        if not all_done(out, comm, progress):
+            return None
+        results = [_read_point(_point_path(out, i)) for i in range(len(points))]
+        study = _assembled(scene, results, time.perf_counter() - clock, comm.size)
+        write_atomic(out / "map.nc", lambda tmp: study["map"].to_netcdf(tmp, engine="h5netcdf"))
+        write_atomic(out / "map.csv", lambda tmp: Path(tmp).write_text(_csv(points, results)))
+        write_json(out / "map.json", study["report"])
+        write_json(out / "summary.json", {"command": "stick-slip-map", "status": "finished", "message": "map.json",
+                                          "points": len(points), "wall_time_s": time.perf_counter() - clock,
+                                          **scene_record(scene)})
+    return study
+
+
+def _csv(points, results) -> str:
+    header = ["controller", "weight_on_bit (N)", "rotation_speed (rad/s)", "settled", "steady_rotation"] + \
+        [f"{name} ({unit})" for name, unit in REPORTED.items()]
+    lines = [",".join(header)]
+    for (controller, w, o), r in zip(points, results):
+        values = [r.get(name) for name in REPORTED]
+        lines.append(",".join([controller, f"{w:.9g}", f"{o:.9g}", str(r["settled"]), str(r["steady_rotation"])]
+                              + ["" if v is None else f"{v:.9g}" for v in values]))
+    return "\n".join(lines) + "\n"
+
+
+def _assembled(scene, results: list[dict], seconds: float, ranks: int) -> dict:
+    import xarray as xr
+
+    m = scene.stick_slip_map
+    weights, speeds = grid(m.weight_on_bit), grid(m.rotation_speed)
+    shape = (len(m.controllers), weights.size, speeds.size)
+
+    def field(name, default=np.nan):
+        values = [default if r.get(name) is None else r[name] for r in results]
+        return np.array(values, dtype=float).reshape(shape)
+
+    dims = ("controller", "weight_on_bit", "rotation_speed")
+    data = {name: (dims, field(name), {"units": unit}) for name, unit in REPORTED.items()}
+    data["settled"] = (dims, field("settled").astype(bool))
+    data["steady_rotation"] = (dims, field("steady_rotation").astype(bool))
+    dataset = xr.Dataset(data, coords={"controller": list(m.controllers),
+                                       "weight_on_bit": ("weight_on_bit", weights, {"units": "N"}),
+                                       "rotation_speed": ("rotation_speed", speeds, {"units": "rad/s"})},
+                         attrs={"time_limit_s": m.time_limit, "drive_mode": scene.drive.mode,
+                                "bit_rock_law": scene.bit_rock.law})
+    report = {"points": len(results), "ranks": ranks, "wall_time_s": seconds,
+              "settled_points": int(sum(bool(r["settled"]) for r in results)),
+              "failed_points": [i for i, r in enumerate(results) if r.get("failed")],
+              "drive_mode": scene.drive.mode, "bit_rock_law": scene.bit_rock.law,
+              "controllers": {c: {"stick_slip_points": int(np.sum(field("stuck_share")[k] > 0.0)),
+                                  "steady_points": int(np.sum(field("steady_rotation")[k] > 0.5))}
+                              for k, c in enumerate(m.controllers)}}
+    return {"report": report, "map": dataset}
