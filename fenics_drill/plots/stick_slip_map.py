@@ -38,6 +38,9 @@ def stick_slip_map_figure(grid, path: Path) -> Path:
                              squeeze=False)
     rpm = grid["rotation_speed"].values * 30.0 / np.pi
     weight = grid["weight_on_bit"].values / 1e3
+    # one colour scale per quantity, shared by the drives
+    finite = {name: grid[name].values[np.isfinite(grid[name].values)] * scale for name, _, scale, _ in PANELS}
+    limits = {name: (v.min(), v.max()) if v.size else (0.0, 1.0) for name, v in finite.items()}
     for row, controller in enumerate(controllers):
         at = grid.sel(controller=controller)
         unsettled = ~at["settled"].values
@@ -45,7 +48,7 @@ def stick_slip_map_figure(grid, path: Path) -> Path:
             ax = axes[row, col]
             values = at[name].values * scale
             mesh = ax.pcolormesh(_edges(rpm), _edges(weight), np.ma.masked_invalid(values), cmap=cmap,
-                                 shading="flat")
+                                 shading="flat", vmin=limits[name][0], vmax=limits[name][1])
             fig.colorbar(mesh, ax=ax)
             for i, j in zip(*np.nonzero(unsettled)):
                 ax.text(rpm[j], weight[i], "x", ha="center", va="center", color="grey")

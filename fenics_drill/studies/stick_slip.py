@@ -272,7 +272,7 @@ def limit_cycle(scene, time_limit: float, dt: float | None = None, simulation: S
         simulation.run(min(window, time_limit - simulation.time))
         if progress is not None:
             progress(simulation.time)
-        if simulation.time >= TRANSIENT_WINDOWS * window:
+        if simulation.time >= (TRANSIENT_WINDOWS + 1) * window * (1.0 - 1e-9):  # a whole window past the transient
             series = simulation.series()
             kind, rows = settled_cycle(series, omega, max(TRANSIENT_WINDOWS * window,
                                                           simulation.time - HISTORY_WINDOWS * window))

@@ -6,16 +6,15 @@ import math
 import numpy as np
 import pytest
 
+from axial_torsional_references import steady_rotation_references
 from string_references import rod_frequencies
 from test_modes_in_the_well import COLLAR, HEAVY_WEIGHT, PIPE, segments, vertical_string
 
 import fenics_drill as fd
 from fenics_drill.cli import main
-from fenics_drill.forms.properties import section_constants
 from fenics_drill.model.discretization import DRIVE, THETA_X, THETA_Y, THETA_Z, V, W, BeamDiscretization
 from fenics_drill.model.operators import assemble_linear
 from fenics_drill.model.reduction.modes import solve_modes
-from fenics_drill.model.string_sections import string_sections
 
 
 def test_the_lateral_fields_are_held_above_the_lateral_length():
@@ -92,39 +91,23 @@ def test_the_axial_torsional_strings_modes_are_the_transfer_matrix_roots(held):
 
 
 def test_a_steadily_rotating_axial_torsional_string_on_bottom_carries_the_soft_strings_hook_load_and_torque():
-    """The 900 m build-and-hold demo well, axial-torsional, drilled at 240 rpm and 15 m/h with the paper's bit law
-    (no stick-slip at that speed), against the soft string (``torque-drag``) rotating on bottom at the run's mean
-    bit force, bit torque and rate of penetration: the hook load, and the surface torque less the viscous torque
-    (38) of the string turning at the drive's speed, c Omega sum(rho I_p L) over the sections (closed form), each
-    within 2 % (measured 0.14 % and 0.9 %: the FE wall acts at the vertices of 10 m elements, the soft string's at
-    2 m, and the torsional oscillation's residue).
+    """:func:`~axial_torsional_references.steady_rotation_references` on ``fenics-drill run``: the hook load and the surface torque each within
+    2 % of the soft string's (measured 0.14 % and 0.4 %: the FE wall acts at the vertices of 10 m elements, the soft
+    string's at 2 m, and the torsional oscillation's residue)."""
+    def means_of(scene):
+        run = fd.run(scene)
+        assert run.summary["status"] == "finished"
+        s = run.series
+        t = s["time"].values
+        late = t > 4.0
 
-    The weight on bit the wall's normal force is computed for is the law's steady force at that rate,
-    Gamma (1 - exp(-alpha V0)); the damping c = 2 /s settles the start's torsional waves within the run (a string
-    sliding steadily on the wall is not damped by its Coulomb friction).  Mean over the last 2 s of 6 s."""
-    scene = fd.load_scene("demos/scenes/well_build_hold.toml", [
-        "model.lateral_length=0.0", "beam.elements=90", "time.t_end=6", "output.field_interval=0",
-        "drive.rotation_speed='240 rpm'", "bit_rock.law='paper'", "drive.mode='velocity'", "beam.damping=2.0"])
-    b = scene.bit_rock
-    steady_force = b.limit_force * -math.expm1(-b.rate * scene.drive.axial_velocity)
-    scene = scene.with_changes(drive={"weight_on_bit": steady_force})
-    run = fd.run(scene)
-    assert run.summary["status"] == "finished"
-    s = run.series
-    t = s["time"].values
-    late = t > 4.0
+        def mean(name):
+            return float(np.trapezoid(s[name].values[late], t[late]) / (t[late][-1] - t[late][0]))
 
-    def mean(name):
-        return float(np.trapezoid(s[name].values[late], t[late]) / (t[late][-1] - t[late][0]))
+        return {"hook_load": mean("lambda_1"), "surface_torque": -mean("lambda_4"),
+                "weight_on_bit": -mean("bit_force"), "bit_torque": -mean("bit_torque"), "rop": mean("bit_velocity"),
+                "spin": s["bit_angular_velocity"].values[late]}
 
-    omega = scene.drive.rotation_speed
-    spin = s["bit_angular_velocity"].values[late]
-    assert np.all(np.abs(spin / omega - 1.0) < 0.05)  # steady rotation, no stick-slip
-    soft = fd.torque_drag(scene.with_changes(torque_drag={
-        "weight_on_bit": -mean("bit_force"), "torque_on_bit": -mean("bit_torque"),
-        "rate_of_penetration": mean("bit_velocity")})).report["operations"]["rotating_on_bottom"]
-    viscous = sum(scene.beam.damping * omega * s_.mass_per_length / (math.pi * (s_.outer_radius**2 - s_.inner_radius**2))
-                  * 2.0 * section_constants(s_.outer_radius, s_.inner_radius).I4 * s_.rotary_inertia_factor
-                  * (s_.bottom - s_.top) for s_ in string_sections(scene))
-    assert mean("lambda_1") == pytest.approx(soft["hook_load_N"], rel=0.02)
-    assert -mean("lambda_4") - viscous == pytest.approx(soft["surface_torque_Nm"], rel=0.02)
+    _, means, (hook, torque) = steady_rotation_references(means_of)
+    assert means["hook_load"] == pytest.approx(hook, rel=0.02)
+    assert means["surface_torque"] == pytest.approx(torque, rel=0.02)

@@ -1,0 +1,157 @@
+"""The compiled axial-torsional string and its stick-slip maps: the band's algebra against dense algebra, the steps
+against the finite-element model's run of the same string, steady rotation against the soft string, the limit cycle
+against itself at half the step, what a map reports and refuses."""
+
+import math
+
+import numpy as np
+import pytest
+import xarray
+from axial_torsional_references import steady_rotation_references
+
+import fenics_drill as fd
+from fenics_drill.cli import main
+from fenics_drill.solvers.axial_torsional_step import band_matvec, band_solve
+from fenics_drill.studies.stick_slip import cycle_metrics, limit_cycle, start
+
+BUILD_HOLD = "demos/scenes/well_build_hold.toml"
+
+
+def test_the_band_solve_and_product_are_dense_algebra():
+    """A random band of half-width 3 with a dominant diagonal (as c_a M makes the step's tangent): its product and
+    its solve without pivoting against NumPy's dense ones, to round-off (1e-12 of the solution)."""
+    rng = np.random.default_rng(7)
+    n, w = 60, 3
+    band = rng.normal(size=(n, 2 * w + 1))
+    band[:, w] += 20.0
+    dense = np.zeros((n, n))
+    for i in range(n):
+        for j in range(max(0, i - w), min(n, i + w + 1)):
+            dense[i, j] = band[i, j - i + w]
+    x = rng.normal(size=n)
+    np.testing.assert_allclose(band_matvec(band, w, x), dense @ x, rtol=0, atol=1e-12 * np.abs(dense @ x).max())
+    rhs = rng.normal(size=n)
+    np.testing.assert_allclose(band_solve(band.copy(), w, rhs), np.linalg.solve(dense, rhs), rtol=0,
+                               atol=1e-12 * np.abs(np.linalg.solve(dense, rhs)).max())
+
+
+def test_the_compiled_steps_follow_the_finite_element_models_run_of_the_same_string():
+    """The 900 m build-and-hold demo well (90 elements), axial-torsional, drilling in stick-slip at 60 rpm under a
+    hook-load drive with the cutting law: the compiled steps against ``fenics-drill run`` with
+    ``model.lateral_length = 0`` (the same forms, wall law and bit law; adaptive Newmark steps there, fixed ones
+    here).  Over the last 1.5 s of 3 s, the means of the surface torque and the weight on bit within 2 % (measured
+    0.5 % and 0.2 %), the bit's fastest spin within 3 % of it (measured 0.4 %) and its stuck share within 0.05:
+    two integrations of one stick-slip drift apart by their steps' errors."""
+    scene = fd.load_scene(BUILD_HOLD, ["beam.elements=90", "model.lateral_length=0.0", "time.t_end=3",
+                                       "output.field_interval=0"])
+    compiled = start(scene).run(3.0)
+    fe = fd.run(scene).series
+    t_fe = fe["time"].values
+
+    def mean(t, values):
+        late = t > 1.5
+        return float(np.trapezoid(values[late], t[late]) / (t[late][-1] - t[late][0]))
+
+    t = compiled["time"]
+    assert mean(t, compiled["top_torque"]) == pytest.approx(mean(t_fe, -fe["lambda_4"].values), rel=0.02)
+    assert mean(t, compiled["bit_force"]) == pytest.approx(mean(t_fe, fe["bit_force"].values), rel=0.02)
+    spin, spin_fe = compiled["bit_angular_velocity"][t > 1.5], fe["bit_angular_velocity"].values[t_fe > 1.5]
+    assert spin.max() == pytest.approx(spin_fe.max(), rel=0.03)
+    omega = scene.drive.rotation_speed
+    assert abs(np.mean(spin < 0.01 * omega) - np.mean(spin_fe < 0.01 * omega)) < 0.05
+
+
+def test_steady_rotation_on_bottom_carries_the_soft_strings_hook_load_and_torque():
+    """:func:`~axial_torsional_references.steady_rotation_references` on the compiled steps: the hook load and the surface
+    torque each within 2 % of the soft string's."""
+    def means_of(scene):
+        series = start(scene).run(6.0)
+        t = series["time"]
+        late = t > 4.0
+
+        def mean(name):
+            return float(np.trapezoid(series[name][late], t[late]) / (t[late][-1] - t[late][0]))
+
+        return {"hook_load": -mean("top_force"), "surface_torque": mean("top_torque"),
+                "weight_on_bit": -mean("bit_force"), "bit_torque": -mean("bit_torque"), "rop": mean("bit_velocity"),
+                "spin": series["bit_angular_velocity"][late]}
+
+    _, means, (hook, torque) = steady_rotation_references(means_of)
+    assert means["hook_load"] == pytest.approx(hook, rel=0.02)
+    assert means["surface_torque"] == pytest.approx(torque, rel=0.02)
+
+
+def test_a_stick_slip_cycle_repeats_and_turns_the_bit_as_fast_as_the_top_on_average():
+    """The build-and-hold well at 20 kN and 60 rpm with the cutting law: the cycle settles within 100 s, the bit
+    sticks for part of it, and over its whole cycles the bit turns on average as fast as the top (the string's
+    twist is bounded): mean spin within 1 % of the drive's speed."""
+    scene = fd.load_scene(BUILD_HOLD, ["beam.elements=90", "drive.weight_on_bit='20 kN'"])
+    cycle = limit_cycle(scene, 100.0)
+    assert cycle["settled"] and not cycle["steady_rotation"]
+    assert cycle["stuck_share"] > 0.05 and cycle["period_s"] > 0.0
+    assert cycle["mean_bit_spin_rad_s"] == pytest.approx(scene.drive.rotation_speed, rel=0.01)
+
+
+def test_steady_rotation_is_reported_as_such():
+    """At 240 rpm with the paper's law and the damping (38) at 2 /s, the bit turns steadily: settled, no period,
+    and the severity below the spin tolerance."""
+    scene = fd.load_scene(BUILD_HOLD, ["beam.elements=90", "drive.rotation_speed='240 rpm'", "bit_rock.law='paper'",
+                                       "drive.mode='velocity'", "beam.damping=2.0"])
+    cycle = limit_cycle(scene, 60.0)
+    assert cycle["settled"] and cycle["steady_rotation"] and cycle["period_s"] is None
+    assert cycle["severity"] < 0.01
+
+
+def test_the_limit_cycle_converges_with_the_step():
+    """The VBH demo well (150 elements) at 25 kN and 60 rpm under its velocity drive: the limit cycle at the default
+    step (the mean element's axial transit time, 4 ms) and at half of it.  Severity, period and mean surface torque
+    within 0.5 % (measured at 2, 1 and 0.5 ms on 300 elements: 1e-4, 2e-4, 1e-5); the mesh is checked the same
+    way in docs/performance.md."""
+    scene = fd.load_scene("demos/scenes/well_vbh.toml", ["beam.elements=150", "drive.weight_on_bit='25 kN'"])
+    coarse = limit_cycle(scene, 150.0)
+    fine = limit_cycle(scene, 150.0, dt=coarse["dt_s"] / 2)
+    assert coarse["settled"] and fine["settled"]
+    for key in ("severity", "period_s", "surface_torque_N_m"):
+        assert coarse[key] == pytest.approx(fine[key], rel=5e-3), key
+
+
+def test_the_mechanical_specific_energy_is_teales():
+    """Teale's MSE at the bit for a steady drilling record: W / A + T omega / (A rop)."""
+    t = np.linspace(0.0, 1.0, 11)
+    series = {"time": t, "bit_angular_velocity": np.full(11, 10.0), "top_torque": np.full(11, 5e3),
+              "top_force": np.full(11, -2e5), "bit_force": np.full(11, -4e4), "bit_torque": np.full(11, -2e3),
+              "bit_velocity": np.full(11, 0.005)}
+    area = math.pi * 0.108**2
+    m = cycle_metrics(series, 10.0, area, steady=True)
+    assert m["mechanical_specific_energy_Pa"] == pytest.approx(4e4 / area + 2e3 * 10.0 / (area * 0.005), rel=1e-12)
+    assert m["severity"] == 0.0 and m["hook_load_N"] == pytest.approx(2e5)
+
+
+def test_a_map_writes_its_table_and_figure(tmp_path, capsys):
+    """A 1 x 2 map of the build-and-hold well, each point to its cycle or 30 s: map.nc, map.csv (units in the
+    header) and the figure, and the severity table printed."""
+    out = tmp_path / "map"
+    assert main(["stick-slip-map", BUILD_HOLD, "--set", "stick_slip_map.weight_on_bit=['20 kN', '20 kN', 1]",
+                 "--set", "stick_slip_map.rotation_speed=['60 rpm', '120 rpm', 2]", "--set",
+                 "stick_slip_map.time_limit=30", "--set", "stick_slip_map.element_length=20", "--out", str(out),
+                 "--quiet"]) == 0
+    grid = xarray.load_dataset(out / "map.nc", engine="h5netcdf")
+    assert grid["severity"].shape == (1, 1, 2)
+    assert grid["rotation_speed"].values == pytest.approx([2 * math.pi, 4 * math.pi])
+    assert (out / "map.csv").read_text().splitlines()[0].startswith("controller,weight_on_bit (N),rotation_speed")
+    assert (out / "stick_slip_map.png").exists()
+    assert "stick-slip severity" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("setting, words", [
+    ("stick_slip_map.weight_on_bit=['20 kN', '400 kN', 2]", "cannot start: drive.weight_on_bit = 400000 N"),
+    ("stick_slip_map.weight_on_bit=[20e3, 40e3, 0]", "stick_slip_map.weight_on_bit = [20000.0, 40000.0, 0] is not"),
+    ("stick_slip_map.controllers=[]", "stick_slip_map.controllers = [] is not admissible"),
+    ("stick_slip_map.rotation_speed=[0.0, 6.0, 2]", "rotation_speed must be > 0 at every point"),
+])
+def test_a_map_that_cannot_be_drawn_is_refused_in_one_line(tmp_path, capsys, setting, words):
+    out = tmp_path / "map"
+    assert main(["stick-slip-map", BUILD_HOLD, "--set", setting, "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert words in err and len(err.strip().splitlines()) == 1, err
+    assert not out.exists()
