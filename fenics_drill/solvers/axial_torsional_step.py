@@ -54,25 +54,40 @@ def band_matvec(band, w, x):
 
 
 @njit(cache=True)
+def _inertia_damping_stiffness(mass, damping, stiffness, w, acc, vel, x):
+    """M acc + C vel + K x in one pass over the bands."""
+    n = x.size
+    out = np.zeros(n)
+    for i in range(n):
+        low, high = max(0, i - w), min(n, i + w + 1)
+        s = 0.0
+        for j in range(low, high):
+            k = j - i + w
+            s += mass[i, k] * acc[j] + damping[i, k] * vel[j] + stiffness[i, k] * x[j]
+        out[i] = s
+    return out
+
+
+@njit(cache=True)
 def band_solve(band, w, rhs):
     """x of band x = rhs by Gaussian elimination without pivoting; ``band`` is overwritten by its LU."""
     n = rhs.size
     x = rhs.copy()
     for k in range(n):
-        pivot = band[k, w]
-        for i in range(k + 1, min(n, k + w + 1)):
-            factor = band[i, k - i + w] / pivot
-            if factor == 0.0:
-                continue
-            band[i, k - i + w] = factor
-            for j in range(k + 1, min(n, k + w + 1)):
-                band[i, j - i + w] -= factor * band[k, j - k + w]
+        inverse = 1.0 / band[k, w]
+        band[k, w] = inverse  # kept as the reciprocal for the back substitution
+        last = min(n, k + w + 1)
+        for i in range(k + 1, last):
+            factor = band[i, k - i + w] * inverse
+            shift = k - i
+            for j in range(k + 1, last):
+                band[i, j - k + w + shift] -= factor * band[k, j - k + w]
             x[i] -= factor * x[k]
     for i in range(n - 1, -1, -1):
         s = x[i]
         for j in range(i + 1, min(n, i + w + 1)):
             s -= band[i, j - i + w] * x[j]
-        x[i] = s / band[i, w]
+        x[i] = s * band[i, w]
     return x
 
 
@@ -114,16 +129,17 @@ def _previous_pass(surface, count, pruned, feed, passage, angle):
 
 
 @njit(cache=True)
-def _residual(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind, bit_law,
-              drive, gamma, c_a, c_v, h, q, q_pred, v_pred, x, anchor, held, trial_held, surface, surface_state,
-              tangent):
-    """The residual of the step to x (the drive's held rows zero), with its tangent written into ``tangent`` and
+def _residual(mass, damping, stiffness, base, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind,
+              bit_law, drive, gamma, c_a, c_v, h, q, q_pred, v_pred, x, anchor, held, trial_held, surface,
+              surface_state, tangent):
+    """The residual of the step to x (the drive's held rows zero), with its tangent (from ``base`` = K + c_v C + c_a M)
+    written into ``tangent`` and
     the wall's forces into ``trial_held``; and what is recorded of it: (residual, bit force, bit torque, depth of
     cut, stuck vertices, top force, top torque, z)."""
     acc = (x - q_pred) * c_a
     vel = v_pred + gamma * h * acc
-    residual = band_matvec(mass, w, acc) + band_matvec(damping, w, vel) + band_matvec(stiffness, w, x) - gravity
-    tangent[:, :] = stiffness + c_v * damping + c_a * mass
+    residual = _inertia_damping_stiffness(mass, damping, stiffness, w, acc, vel, x) - gravity
+    tangent[:, :] = base
     trial_held[:, :] = held
     stuck = _wall(x, wall_dofs, normal, arm, wall_law[0], wall_law[1], anchor, trial_held, residual, tangent, w)
     tu, tt = top
@@ -176,7 +192,8 @@ def _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, 
              drive, h, newmark, tolerance, max_iterations, q, v, a, t, anchor, held, trial_held, surface,
              surface_state, tangent):
     """One Newmark step of ``h`` from (q, v, a) at t by Newton, an update halved while it does not reduce the
-    residual (at most :data:`BACKTRACKS` times).  Returns (converged, x, recorded values of :func:`_residual`)."""
+    residual (at most :data:`BACKTRACKS` times).  Returns (converged, x, recorded values of :func:`_residual`,
+    iterations)."""
     gamma, beta = newmark
     c_a = 1.0 / (beta * h * h)
     c_v = gamma / (beta * h)
@@ -188,7 +205,8 @@ def _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, 
     if drive[3] > 0.5:
         x[top[1]] = drive[4] * (t + h)
     scale = max(np.max(np.abs(gravity)) * q.size, abs(drive[2]), 1.0)
-    ev = _residual(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind,
+    base = stiffness + c_v * damping + c_a * mass
+    ev = _residual(mass, damping, stiffness, base, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind,
                    bit_law, drive, gamma, c_a, c_v, h, q, q_pred, v_pred, x, anchor, held, trial_held, surface,
                    surface_state, tangent)
     norm = np.max(np.abs(ev[0]))
@@ -197,7 +215,7 @@ def _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, 
         cut = 1.0
         for _ in range(BACKTRACKS + 1):
             trial = x + cut * dx
-            trial_ev = _residual(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law,
+            trial_ev = _residual(mass, damping, stiffness, base, w, gravity, top, bit, wall_dofs, normal, arm, wall_law,
                                  bit_kind, bit_law, drive, gamma, c_a, c_v, h, q, q_pred, v_pred, trial, anchor,
                                  held, trial_held, surface, surface_state, tangent)
             trial_norm = np.max(np.abs(trial_ev[0]))
@@ -206,8 +224,8 @@ def _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, 
             cut *= 0.5
         x, ev, norm = trial, trial_ev, trial_norm
         if norm <= tolerance * scale or np.max(np.abs(cut * dx)) <= ROUND_OFF * (np.max(np.abs(x)) + 1.0):
-            return True, x, ev
-    return False, x, ev
+            return True, x, ev, iteration + 1
+    return False, x, ev, max_iterations
 
 
 #: Halvings of a Newton update that does not reduce the residual; halvings of a step that does not converge.
@@ -220,7 +238,7 @@ ROUND_OFF = 1e-14
 @kernel
 def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind, bit_law,
             drive, dt, newmark, tolerance, max_iterations, steps, stride, q, v, a, clock, anchor, held, surface,
-            surface_state, records):
+            surface_state, records, counters):
     """Take ``steps`` steps of ``dt`` from the state (q, v, a) at ``clock[0]`` (all updated in place) and write a
     row of :data:`RECORDED` into ``records`` every ``stride`` steps.  A step whose Newton does not converge is
     taken in halves (down to dt / 2^:data:`SUBSTEP_HALVINGS`).  Returns (status, rows written).
@@ -229,7 +247,8 @@ def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, a
     mu, R; :data:`CUTTING`: :attr:`CuttingBit.law_constants` then the blade passage); ``drive``: (axial held,
     V0, top force, rotation held, Omega, k_p, k_i, T_max, z); ``anchor``, ``held``: each vertex's (u, theta_x)
     and (F_a, F_t) at the last step; ``surface``: (2, capacity) angles and surfaces of the cut bottom with
-    ``surface_state`` = (count, pruned, feed per radian)."""
+    ``surface_state`` = (count, pruned, feed per radian); ``counters``: (steps, Newton iterations, steps halved)
+    added to."""
     gamma = newmark[0]
     bu, bt = bit
     tangent = np.empty_like(mass)
@@ -239,10 +258,12 @@ def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, a
         remaining, h = dt, dt
         while remaining > 1e-9 * dt:
             h = min(h, remaining)
-            ok, x, ev = _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law,
+            ok, x, ev, iterations = _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law,
                                  bit_kind, bit_law, drive, h, newmark, tolerance, max_iterations, q, v, a, clock[0],
                                  anchor, held, trial_held, surface, surface_state, tangent)
+            counters[1] += iterations
             if not ok:
+                counters[2] += 1
                 h *= 0.5
                 if h < dt / 2.0**SUBSTEP_HALVINGS:
                     return NOT_CONVERGED, rows
@@ -260,6 +281,7 @@ def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, a
             drive[8] = ev[7]
             clock[0] += h
             remaining -= h
+            counters[0] += 1
         if (step + 1) % stride == 0 and rows < records.shape[0]:
             row = records[rows]
             row[0], row[1], row[2], row[3], row[4] = clock[0], v[bu], v[bt], ev[1], ev[2]

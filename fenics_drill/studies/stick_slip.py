@@ -41,7 +41,7 @@ SHARE_TOLERANCE = 0.02  # of the time, for the stuck share
 TORQUE_TOLERANCE = 0.02  # of the mean surface torque
 PERIOD_TOLERANCE = 0.02  # of the cycle's duration
 #: Newton's stop (the residual's largest entry against the string's weight) and its iterations per step.
-TOLERANCE, MAX_ITERATIONS = 1e-10, 40
+TOLERANCE, MAX_ITERATIONS = 1e-8, 40
 #: The cut bottom's memory: (angle, surface) entries kept (more than two revolutions of accepted steps).
 SURFACE_CAPACITY = 1 << 16
 
@@ -62,6 +62,8 @@ class Simulation:
     state: tuple  # q, v, a, clock, anchor, held, surface, surface_state
     stride: int = 1
     records: list = field(default_factory=list)
+    #: Steps taken (halves included), Newton iterations, steps halved.
+    counters: np.ndarray = field(default_factory=lambda: np.zeros(3, dtype=np.int64))
 
     @property
     def time(self) -> float:
@@ -72,7 +74,7 @@ class Simulation:
         steps = max(1, int(round(duration / self.dt)))
         rows = np.empty((steps // self.stride + 1, len(RECORDED)))
         status, written = advance(*self.constants, self.drive, self.dt, self.newmark, TOLERANCE, MAX_ITERATIONS,
-                                  steps, self.stride, *self.state, rows)
+                                  steps, self.stride, *self.state, rows, self.counters)
         if status != CONVERGED:
             raise StepFailed(f"Newton did not converge in {MAX_ITERATIONS} iterations after t = {self.time:.6g} s "
                              f"(step {self.dt:.3g} s); a smaller time.dt may")
@@ -282,5 +284,7 @@ def limit_cycle(scene, time_limit: float, dt: float | None = None, simulation: S
         series = simulation.series()
         rows = _part(series, series["time"] > series["time"][-1] - TRANSIENT_WINDOWS * window)
     out = cycle_metrics(rows, omega, bit_area(scene), kind == "steady")
-    out.update(settled=kind is not None, time_s=simulation.time, window_s=window, dt_s=simulation.dt)
+    steps, iterations, halved = (int(c) for c in simulation.counters)
+    out.update(settled=kind is not None, time_s=simulation.time, window_s=window, dt_s=simulation.dt, steps=steps,
+               newton_iterations_per_step=iterations / max(steps, 1), steps_halved=halved)
     return out
