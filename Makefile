@@ -2,7 +2,7 @@
 PY := .venv/bin/python
 OUT ?= out
 
-.PHONY: setup docs demo demo-printed demo-as-printed reproduction test bench bench-ross campbell wells drilling drill-vbh risk mc optimize stick-slip clean
+.PHONY: setup docs demo demo-printed demo-as-printed reproduction test bench bench-ross campbell wells drilling drill-vbh risk mc optimize stick-slip well-maps clean
 
 setup:
 	@bash scripts/bootstrap.sh
@@ -154,6 +154,20 @@ stick-slip: setup
 	$(PY) -m fenics_drill.cli plot $(OUT)/stick-slip-soft
 	$(PY) benchmarks/stick_slip_table.py $(OUT)/stick-slip-stiff $(OUT)/stick-slip-soft
 	$(PY) benchmarks/stick_slip_stability.py
+
+## Stick-slip maps of the demo wells on their axial-torsional strings (docs/guide/stick_slip_maps.md): weight on bit x
+## rotation speed, 8 x 8 points, the stiff drive and the soft-torque top drive, each point to its limit cycle or 200 s,
+## on RANKS processes; the figures copied into docs/figures.
+WELL_MAP = --set drive.mode=\'hook_load\' --set bit_rock.law=\'detournay\' --set "bit_rock.bit_radius='4.25 in'" \
+	--set "stick_slip_map.weight_on_bit=['20 kN', '90 kN', 8]" --set "stick_slip_map.rotation_speed=['40 rpm', '180 rpm', 8]" \
+	--set "stick_slip_map.controllers=['stiff', 'soft_torque']"
+well-maps: setup
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli stick-slip-map demos/scenes/well_vbh.toml $(WELL_MAP) \
+		--overwrite --out $(OUT)/vbh-map
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli stick-slip-map demos/scenes/well_build_hold.toml $(WELL_MAP) \
+		--overwrite --out $(OUT)/build-hold-map
+	cp $(OUT)/vbh-map/stick_slip_map.png docs/figures/stick_slip_map_vbh.png
+	cp $(OUT)/build-hold-map/stick_slip_map.png docs/figures/stick_slip_map_build_hold.png
 
 clean:
 	rm -rf $(OUT) .pytest_cache docs/_build docs/gallery docs/reference/api.md docs/reference/scene_keys.md

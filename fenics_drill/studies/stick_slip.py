@@ -5,10 +5,11 @@ state on bottom at ``drive.weight_on_bit``, or hanging off bottom, moving at the
 compiled steps of :mod:`~fenics_drill.solvers.axial_torsional_step`.  :func:`limit_cycle` steps it window by window
 (each two of the string's first torsional periods 4 L / c_T, held at the top and free at the bit) until, past the
 start's transient, the bit's spin stays within :data:`SPIN_TOLERANCE` of the drive's speed (steady rotation), or its
-last :data:`SETTLED_CYCLES` cycles (from one rise of the spin through the drive's speed to the next) repeat: their
-fastest and slowest spin within :data:`SPIN_TOLERANCE` of the drive's speed, their stuck shares within
-:data:`SHARE_TOLERANCE`, their mean surface torques within :data:`TORQUE_TOLERANCE` and their durations within
-:data:`PERIOD_TOLERANCE`.  Or until a time limit; the report says which (:func:`cycle_metrics`).
+last block of :data:`SETTLED_CYCLES` cycles (from one rise of the spin through the drive's speed to the next)
+repeats the block before it: their fastest and slowest spin within :data:`SPIN_TOLERANCE` of the drive's speed,
+their stuck shares within :data:`SHARE_TOLERANCE`, their mean surface torques within :data:`TORQUE_TOLERANCE` and
+their mean periods within :data:`PERIOD_TOLERANCE` (a stick-slip whose cycles differ a little from one to the next
+settles in its statistics).  Or until a time limit; the report says which (:func:`cycle_metrics`).
 
 Signs: ``top_force`` is the force the drive applies to the top along the string (down-hole), so the hook load is
 its negative; ``top_torque`` is the torque it applies (positive while it turns the string); ``bit_force`` and
@@ -33,13 +34,14 @@ from fenics_drill.solvers.newmark import newmark_parameters
 
 #: A bit turning slower than this share of the drive's speed is stuck.
 STUCK_SHARE = 0.01
-#: The cycles over which a limit cycle must repeat, and how closely; the windows (two first torsional periods
-#: each) taken as the start's transient, and those searched for repeating cycles.
+#: The cycles of a block: a limit cycle has settled when the last block of cycles repeats the one before it, within
+#: the tolerances below; the windows (two first torsional periods each) taken as the start's transient, and those
+#: searched for cycles.
 SETTLED_CYCLES, TRANSIENT_WINDOWS, HISTORY_WINDOWS = 3, 2, 8
-SPIN_TOLERANCE = 0.02  # of the drive's speed, for the bit's fastest and slowest spin
-SHARE_TOLERANCE = 0.02  # of the time, for the stuck share
+SPIN_TOLERANCE = 0.03  # of the drive's speed, for the bit's fastest and slowest spin
+SHARE_TOLERANCE = 0.03  # of the time, for the stuck share
 TORQUE_TOLERANCE = 0.02  # of the mean surface torque
-PERIOD_TOLERANCE = 0.02  # of the cycle's duration
+PERIOD_TOLERANCE = 0.03  # of the cycle's mean duration
 #: Newton's stop (the residual's largest entry against the string's weight) and its iterations per step.
 TOLERANCE, MAX_ITERATIONS = 1e-8, 40
 #: The cut bottom's memory: (angle, surface) entries kept (more than two revolutions of accepted steps).
@@ -190,62 +192,85 @@ def window_metrics(series: dict, rotation_speed: float) -> dict:
 
 
 def cycles(series: dict, rotation_speed: float) -> list[slice]:
-    """The rows of each whole cycle of the bit's spin: from one rise through the drive's speed to the next."""
-    above = series["bit_angular_velocity"] > rotation_speed
-    rising = np.flatnonzero(~above[:-1] & above[1:]) + 1
-    return [slice(a, b + 1) for a, b in zip(rising[:-1], rising[1:])]
+    """The rows of each whole cycle of the bit's spin: from one rise through the drive's speed to the next, a rise
+    counting only after the spin has fallen a quarter of its range below that speed (a chattering crossing is not
+    a cycle)."""
+    spin = series["bit_angular_velocity"]
+    if spin.size < 2:
+        return []
+    low = rotation_speed - 0.25 * np.ptp(spin)
+    rises, armed = [], False
+    for i in range(1, spin.size):
+        if spin[i] < low:
+            armed = True
+        elif armed and spin[i - 1] <= rotation_speed < spin[i]:
+            rises.append(i)
+            armed = False
+    return [slice(a, b + 1) for a, b in zip(rises[:-1], rises[1:])]
 
 
 def _part(series: dict, rows: slice) -> dict:
     return {name: values[rows] for name, values in series.items()}
 
 
-def repeating(parts: list[dict], rotation_speed: float) -> bool:
-    """Whether the metrics of ``parts`` (:func:`window_metrics` and a duration each) agree (module doc)."""
+def repeating(blocks: list[dict], rotation_speed: float) -> bool:
+    """Whether the metrics of two blocks of cycles (:func:`window_metrics` and the mean cycle's duration each)
+    agree (module doc)."""
     def spread(key):
-        values = [p[key] for p in parts]
+        values = [b[key] for b in blocks]
         return max(values) - min(values)
 
-    torque = max(abs(p["surface_torque"]) for p in parts)
-    duration = max(p["duration"] for p in parts)
+    torque = max(abs(b["surface_torque"]) for b in blocks)
+    period = max(b["period"] for b in blocks)
     return (spread("max_spin") <= SPIN_TOLERANCE * rotation_speed
             and spread("min_spin") <= SPIN_TOLERANCE * rotation_speed
             and spread("stuck_share") <= SHARE_TOLERANCE
             and spread("surface_torque") <= TORQUE_TOLERANCE * max(torque, 1e-30)
-            and spread("duration") <= PERIOD_TOLERANCE * duration)
+            and spread("period") <= PERIOD_TOLERANCE * period)
 
 
 def settled_cycle(series: dict, rotation_speed: float, after: float) -> tuple[str | None, dict | None]:
-    """('steady', rows) where the spin after ``after`` [s] stays within :data:`SPIN_TOLERANCE` of the drive's speed
-    over its last window; ('cycle', rows of the last :data:`SETTLED_CYCLES` cycles) where they repeat; else
-    (None, None)."""
+    """('steady', rows) where the spin after ``after`` [s] stays within :data:`SPIN_TOLERANCE` of the drive's speed;
+    ('cycle', rows of the last :data:`SETTLED_CYCLES` cycles, from a rise to a rise) where they repeat the :data:`SETTLED_CYCLES` before
+    them as a block (:func:`repeating`); else (None, None)."""
     t, spin = series["time"], series["bit_angular_velocity"]
     late = t > after
     if not np.any(late):
         return None, None
     if np.ptp(spin[late]) <= SPIN_TOLERANCE * rotation_speed:
         return "steady", _part(series, late)
-    whole = [c for c in cycles(series, rotation_speed) if t[c][0] > after]
-    if len(whole) < SETTLED_CYCLES:
+    whole = [c for c in cycles(_part(series, late), rotation_speed)]
+    if len(whole) < 2 * SETTLED_CYCLES:
         return None, None
-    last = whole[-SETTLED_CYCLES:]
-    parts = [dict(window_metrics(_part(series, c), rotation_speed), duration=float(np.ptp(t[c]))) for c in last]
-    if not repeating(parts, rotation_speed):
+    late_series = _part(series, late)
+    blocks = []
+    for part in (whole[-2 * SETTLED_CYCLES:-SETTLED_CYCLES], whole[-SETTLED_CYCLES:]):
+        rows = slice(part[0].start, part[-1].stop)
+        blocks.append(dict(window_metrics(_part(late_series, rows), rotation_speed),
+                           period=float(np.ptp(late_series["time"][rows]) / SETTLED_CYCLES)))
+    if not repeating(blocks, rotation_speed):
         return None, None
-    return "cycle", _part(series, slice(last[0].start, last[-1].stop))
+    return "cycle", _part(late_series, slice(whole[-SETTLED_CYCLES].start, whole[-1].stop))
+
+
+def mean_period(series: dict, rotation_speed: float) -> float | None:
+    """The mean duration of the whole cycles in ``series`` (:func:`cycles`), None without one."""
+    whole = cycles(series, rotation_speed)
+    if not whole:
+        return None
+    return float(np.mean([np.ptp(series["time"][c]) for c in whole]))
 
 
 def cycle_metrics(series: dict, rotation_speed: float, bit_area: float, steady: bool) -> dict:
-    """The cycle over ``series``: severity (max - min) / (2 mean) of the bit's spin, its period (``series`` holds
-    whole cycles), the stuck share, the means of the rop, the surface torque, the hook load and the weight on bit,
+    """The cycle over ``series``: severity (max - min) / (2 mean) of the bit's spin, its period (the mean duration
+    of the whole cycles in ``series``), the stuck share, the means of the rop, the surface torque, the hook load and the weight on bit,
     and the mechanical specific energy at the bit, W / A + <T omega> / (A rop) (Teale 1965, with the bit's torque
     and spin) [Pa]."""
     m = window_metrics(series, rotation_speed)
     mean_spin = m["mean_spin"]
-    rises = len(cycles(series, rotation_speed))
     return {
         "severity": float((m["max_spin"] - m["min_spin"]) / (2.0 * mean_spin)) if mean_spin > 0 else math.inf,
-        "period_s": None if steady or rises == 0 else float(np.ptp(series["time"]) / rises),
+        "period_s": None if steady else mean_period(series, rotation_speed),
         "stuck_share": m["stuck_share"], "max_bit_spin_rad_s": m["max_spin"], "min_bit_spin_rad_s": m["min_spin"],
         "mean_bit_spin_rad_s": mean_spin, "rop_m_s": m["rop"], "surface_torque_N_m": m["surface_torque"],
         "hook_load_N": m["hook_load"], "weight_on_bit_N": m["weight_on_bit"], "bit_torque_N_m": m["bit_torque"],
