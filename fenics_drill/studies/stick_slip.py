@@ -5,8 +5,8 @@ state on bottom at ``drive.weight_on_bit``, or hanging off bottom, moving at the
 compiled steps of :mod:`~fenics_drill.solvers.axial_torsional_step`.  :func:`limit_cycle` steps it window by window
 (each two of the string's first torsional periods 4 L / c_T, held at the top and free at the bit) until, past the
 start's transient, the bit's spin stays within :data:`SPIN_TOLERANCE` of the drive's speed (steady rotation), or its
-last block of :data:`SETTLED_CYCLES` cycles (from one rise of the spin through the drive's speed to the next)
-repeats the block before it: their fastest and slowest spin within :data:`SPIN_TOLERANCE` of the drive's speed,
+last block of cycles (from one rise of the spin through the drive's speed to the next; :data:`SETTLED_CYCLES` of
+them, or more until they span a window) repeats the block before it: their fastest and slowest spin within :data:`SPIN_TOLERANCE` of the drive's speed,
 their stuck shares within :data:`SHARE_TOLERANCE`, their mean surface torques within :data:`TORQUE_TOLERANCE` and
 their mean periods within :data:`PERIOD_TOLERANCE` (a stick-slip whose cycles differ a little from one to the next
 settles in its statistics).  Or until a time limit; the report says which (:func:`cycle_metrics`).
@@ -229,28 +229,34 @@ def repeating(blocks: list[dict], rotation_speed: float) -> bool:
             and spread("period") <= PERIOD_TOLERANCE * period)
 
 
-def settled_cycle(series: dict, rotation_speed: float, after: float) -> tuple[str | None, dict | None]:
+def settled_cycle(series: dict, rotation_speed: float, after: float, block: float = 0.0
+                  ) -> tuple[str | None, dict | None]:
     """('steady', rows) where the spin after ``after`` [s] stays within :data:`SPIN_TOLERANCE` of the drive's speed;
-    ('cycle', rows of the last :data:`SETTLED_CYCLES` cycles, from a rise to a rise) where they repeat the :data:`SETTLED_CYCLES` before
-    them as a block (:func:`repeating`); else (None, None)."""
+    ('cycle', rows of the last block of cycles, from a rise to a rise) where it repeats the block before it
+    (:func:`repeating`); else (None, None).  A block is the last :data:`SETTLED_CYCLES` cycles, or more until they
+    span ``block`` seconds (an irregular stick-slip of short cycles settles in the statistics of longer blocks)."""
     t, spin = series["time"], series["bit_angular_velocity"]
     late = t > after
     if not np.any(late):
         return None, None
     if np.ptp(spin[late]) <= SPIN_TOLERANCE * rotation_speed:
         return "steady", _part(series, late)
-    whole = [c for c in cycles(_part(series, late), rotation_speed)]
-    if len(whole) < 2 * SETTLED_CYCLES:
-        return None, None
     late_series = _part(series, late)
+    whole = cycles(late_series, rotation_speed)
+    times = late_series["time"]
+    count = SETTLED_CYCLES  # a block: at least SETTLED_CYCLES cycles, and at least ``block`` seconds of them
+    while count < len(whole) and times[whole[-1].stop - 1] - times[whole[-count].start] < block:
+        count += 1
+    if len(whole) < 2 * count:
+        return None, None
     blocks = []
-    for part in (whole[-2 * SETTLED_CYCLES:-SETTLED_CYCLES], whole[-SETTLED_CYCLES:]):
+    for part in (whole[-2 * count:-count], whole[-count:]):
         rows = slice(part[0].start, part[-1].stop)
         blocks.append(dict(window_metrics(_part(late_series, rows), rotation_speed),
-                           period=float(np.ptp(late_series["time"][rows]) / SETTLED_CYCLES)))
+                           period=float(np.ptp(times[rows]) / count)))
     if not repeating(blocks, rotation_speed):
         return None, None
-    return "cycle", _part(late_series, slice(whole[-SETTLED_CYCLES].start, whole[-1].stop))
+    return "cycle", _part(late_series, slice(whole[-count].start, whole[-1].stop))
 
 
 def mean_period(series: dict, rotation_speed: float) -> float | None:
@@ -302,7 +308,7 @@ def limit_cycle(scene, time_limit: float, dt: float | None = None, simulation: S
         if simulation.time >= (TRANSIENT_WINDOWS + 1) * window * (1.0 - 1e-9):  # a whole window past the transient
             series = simulation.series()
             kind, rows = settled_cycle(series, omega, max(TRANSIENT_WINDOWS * window,
-                                                          simulation.time - HISTORY_WINDOWS * window))
+                                                          simulation.time - HISTORY_WINDOWS * window), window)
             if kind is not None:
                 break
     if kind is None:
