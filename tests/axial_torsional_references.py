@@ -23,7 +23,8 @@ def steady_rotation_references(means_of):
         "model.lateral_length=0.0", "beam.elements=90", "time.t_end=6", "output.field_interval=0",
         "drive.rotation_speed='240 rpm'", "bit_rock.law='paper'", "drive.mode='velocity'", "beam.damping=2.0"])
     b = scene.bit_rock
-    scene = scene.with_changes(drive={"weight_on_bit": b.limit_force * -math.expm1(-b.rate * scene.drive.axial_velocity)})
+    steady_force = b.limit_force * -math.expm1(-b.rate * scene.drive.axial_velocity)
+    scene = scene.with_changes(drive={"weight_on_bit": steady_force})
     means = means_of(scene)
     omega = scene.drive.rotation_speed
     assert np.all(np.abs(means["spin"] / omega - 1.0) < 0.05)  # steady rotation, no stick-slip

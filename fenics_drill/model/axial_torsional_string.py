@@ -105,6 +105,7 @@ def axial_torsional_string(scene) -> AxialTorsionalString:
         gravity=operators.gravity[dofs],
         top=(int(position[disc.end_dof(U, 0)]), int(position[disc.end_dof(THETA_X, 0)])),
         bit=(int(position[disc.end_dof(U, 1)]), int(position[disc.end_dof(THETA_X, 1)])),
-        wall_dofs=vertex, wall_normal=wall_normal_forces(scene, disc.vertex_x), wall_arm=np.asarray(contact_radius, float),
+        wall_dofs=vertex, wall_normal=wall_normal_forces(scene, disc.vertex_x),
+        wall_arm=np.asarray(contact_radius, float),
         polar_inertia_at_top=polar, torsional_wave_speed_at_top=wave, axial_wave_speed=axial,
         length=float(disc.properties.length))

@@ -42,19 +42,7 @@ CONVERGED, NOT_CONVERGED = 0, 1
 
 
 @njit(cache=True)
-def band_matvec(band, w, x):
-    n = x.size
-    out = np.zeros(n)
-    for i in range(n):
-        s = 0.0
-        for j in range(max(0, i - w), min(n, i + w + 1)):
-            s += band[i, j - i + w] * x[j]
-        out[i] = s
-    return out
-
-
-@njit(cache=True)
-def _inertia_damping_stiffness(mass, damping, stiffness, w, acc, vel, x):
+def inertia_damping_stiffness(mass, damping, stiffness, w, acc, vel, x):
     """M acc + C vel + K x in one pass over the bands."""
     n = x.size
     out = np.zeros(n)
@@ -138,7 +126,7 @@ def _residual(mass, damping, stiffness, base, w, gravity, top, bit, wall_dofs, n
     cut, stuck vertices, top force, top torque, z)."""
     acc = (x - q_pred) * c_a
     vel = v_pred + gamma * h * acc
-    residual = _inertia_damping_stiffness(mass, damping, stiffness, w, acc, vel, x) - gravity
+    residual = inertia_damping_stiffness(mass, damping, stiffness, w, acc, vel, x) - gravity
     tangent[:, :] = base
     trial_held[:, :] = held
     stuck = _wall(x, wall_dofs, normal, arm, wall_law[0], wall_law[1], anchor, trial_held, residual, tangent, w)
@@ -241,14 +229,14 @@ def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, a
             surface_state, records, counters):
     """Take ``steps`` steps of ``dt`` from the state (q, v, a) at ``clock[0]`` (all updated in place) and write a
     row of :data:`RECORDED` into ``records`` every ``stride`` steps.  A step whose Newton does not converge is
-    taken in halves (down to dt / 2^:data:`SUBSTEP_HALVINGS`).  Returns (status, rows written).
+    taken in halves (down to dt / 2 ** :data:`SUBSTEP_HALVINGS`).  Returns (status, rows written).
 
     ``wall_law``: (friction, stick stiffness); ``bit_law``: the law's constants (:data:`PAPER`: Gamma, alpha,
-    mu, R; :data:`CUTTING`: :attr:`CuttingBit.law_constants` then the blade passage); ``drive``: (axial held,
-    V0, top force, rotation held, Omega, k_p, k_i, T_max, z); ``anchor``, ``held``: each vertex's (u, theta_x)
-    and (F_a, F_t) at the last step; ``surface``: (2, capacity) angles and surfaces of the cut bottom with
-    ``surface_state`` = (count, pruned, feed per radian); ``counters``: (steps, Newton iterations, steps halved)
-    added to."""
+    mu, R; :data:`CUTTING`: :func:`~fenics_drill.model.forces.cutting_bit.cutting_law_constants` then the blade
+    passage); ``drive``: (axial held, V0, top force, rotation held, Omega, k_p, k_i, T_max, z); ``anchor``,
+    ``held``: each vertex's (u, theta_x) and (F_a, F_t) at the last step; ``surface``: (2, capacity) angles and
+    surfaces of the cut bottom with ``surface_state`` = (count, pruned, feed per radian); ``counters``: (steps,
+    Newton iterations, steps halved), added to."""
     gamma = newmark[0]
     bu, bt = bit
     tangent = np.empty_like(mass)
@@ -258,9 +246,10 @@ def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, a
         remaining, h = dt, dt
         while remaining > 1e-9 * dt:
             h = min(h, remaining)
-            ok, x, ev, iterations = _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law,
-                                 bit_kind, bit_law, drive, h, newmark, tolerance, max_iterations, q, v, a, clock[0],
-                                 anchor, held, trial_held, surface, surface_state, tangent)
+            ok, x, ev, iterations = _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm,
+                                             wall_law, bit_kind, bit_law, drive, h, newmark, tolerance, max_iterations,
+                                             q, v, a, clock[0], anchor, held, trial_held, surface, surface_state,
+                                             tangent)
             counters[1] += iterations
             if not ok:
                 counters[2] += 1

@@ -6,10 +6,11 @@ compiled steps of :mod:`~fenics_drill.solvers.axial_torsional_step`.  :func:`lim
 (each two of the string's first torsional periods 4 L / c_T, held at the top and free at the bit) until, past the
 start's transient, the bit's spin stays within :data:`SPIN_TOLERANCE` of the drive's speed (steady rotation), or its
 last block of cycles (from one rise of the spin through the drive's speed to the next; :data:`SETTLED_CYCLES` of
-them, or more until they span a window) repeats the block before it: their fastest and slowest spin within :data:`SPIN_TOLERANCE` of the drive's speed,
-their stuck shares within :data:`SHARE_TOLERANCE`, their mean surface torques within :data:`TORQUE_TOLERANCE` and
-their mean periods within :data:`PERIOD_TOLERANCE` (a stick-slip whose cycles differ a little from one to the next
-settles in its statistics).  Or until a time limit; the report says which (:func:`cycle_metrics`).
+them, or more until they span a window) repeats the block before it: their fastest and slowest spin within
+:data:`SPIN_TOLERANCE` of the drive's speed, their stuck shares within :data:`SHARE_TOLERANCE`, their mean surface
+torques within :data:`TORQUE_TOLERANCE` and their mean periods within :data:`PERIOD_TOLERANCE` (a stick-slip whose
+cycles differ a little from one to the next settles in its statistics).  Or until a time limit; the report says
+which (:func:`cycle_metrics`).
 
 Signs: ``top_force`` is the force the drive applies to the top along the string (down-hole), so the hook load is
 its negative; ``top_torque`` is the torque it applies (positive while it turns the string); ``bit_force`` and
@@ -24,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fenics_drill.model.axial_torsional_string import AxialTorsionalString, axial_torsional_string
-from fenics_drill.model.forces.cutting_bit import CuttingBit
+from fenics_drill.model.forces.cutting_bit import cutting_law_constants
 from fenics_drill.model.top_drive import controller_gains
 from fenics_drill.model.well import hanging_tension
 from fenics_drill.scene import LAW_SIGN
@@ -108,9 +109,7 @@ def _bit_law(scene, string: AxialTorsionalString) -> tuple[int, np.ndarray]:
         return NO_BIT, np.zeros(9)
     bit = scene.bit_rock
     if bit.law == "detournay":
-        constants = CuttingBit.__new__(CuttingBit)
-        constants._set_parameters(bit)
-        return CUTTING, np.array([*constants.law_constants, 2.0 * math.pi / bit.blades])
+        return CUTTING, np.array([*cutting_law_constants(bit), 2.0 * math.pi / bit.blades])
     sign = LAW_SIGN[scene.law(bit.torque_law)]
     return PAPER, np.array([bit.limit_force, bit.rate, sign * bit.friction, scene.borehole.radius, 0, 0, 0, 0, 0])
 
@@ -269,9 +268,9 @@ def mean_period(series: dict, rotation_speed: float) -> float | None:
 
 def cycle_metrics(series: dict, rotation_speed: float, bit_area: float, steady: bool) -> dict:
     """The cycle over ``series``: severity (max - min) / (2 mean) of the bit's spin, its period (the mean duration
-    of the whole cycles in ``series``), the stuck share, the means of the rop, the surface torque, the hook load and the weight on bit,
-    and the mechanical specific energy at the bit, W / A + <T omega> / (A rop) (Teale 1965, with the bit's torque
-    and spin) [Pa]."""
+    of the whole cycles in ``series``), the stuck share, the means of the rop, the surface torque, the hook load and
+    the weight on bit, and the mechanical specific energy at the bit, W / A + <T omega> / (A rop) (Teale 1965, with
+    the bit's torque and spin) [Pa]."""
     m = window_metrics(series, rotation_speed)
     mean_spin = m["mean_spin"]
     return {

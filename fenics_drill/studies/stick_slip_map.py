@@ -84,7 +84,8 @@ def run_point(scene, string, controller: str, weight_on_bit: float, rotation_spe
     clock = time.perf_counter()
     point = point_scene(scene, controller, weight_on_bit, rotation_speed)
     try:
-        out = limit_cycle(point, point.stick_slip_map.time_limit, simulation=start(point, string=pressed_for(string, point)))
+        simulation = start(point, string=pressed_for(string, point))
+        out = limit_cycle(point, point.stick_slip_map.time_limit, simulation=simulation)
         out["failed"] = None
     except StepFailed as err:
         out = {name: float("nan") for name in REPORTED}

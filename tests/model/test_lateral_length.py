@@ -91,9 +91,9 @@ def test_the_axial_torsional_strings_modes_are_the_transfer_matrix_roots(held):
 
 
 def test_a_steadily_rotating_axial_torsional_string_on_bottom_carries_the_soft_strings_hook_load_and_torque():
-    """:func:`~axial_torsional_references.steady_rotation_references` on ``fenics-drill run``: the hook load and the surface torque each within
-    2 % of the soft string's (measured 0.14 % and 0.4 %: the FE wall acts at the vertices of 10 m elements, the soft
-    string's at 2 m, and the torsional oscillation's residue)."""
+    """:func:`~axial_torsional_references.steady_rotation_references` on ``fenics-drill run``: the hook load and the
+    surface torque each within 2 % of the soft string's (measured 0.14 % and 0.4 %: the FE wall acts at the vertices
+    of 10 m elements, the soft string's at 2 m, and the torsional oscillation's residue)."""
     def means_of(scene):
         run = fd.run(scene)
         assert run.summary["status"] == "finished"

@@ -62,6 +62,16 @@ def surface_at(angles, surfaces, pruned, feed, angle):
     return surfaces[k - 1] + slope * (angle - angles[k - 1]), slope
 
 
+def cutting_law_constants(bit) -> tuple:
+    """The constants of :func:`cutting_law` from the scene's [bit_rock]: (n, zeta eps a, eps a^2 / 2, sigma a l,
+    mu gamma a / 2, v_c, d_c, v_c / a)."""
+    a = bit.bit_radius
+    return (float(bit.blades), bit.cutting_orientation * bit.specific_energy * a, bit.specific_energy * a * a / 2.0,
+            bit.contact_strength * a * bit.wear_flat_length,  # sigma a l
+            bit.friction * bit.geometry_factor * a / 2.0,  # T_f = mu gamma a W_f / 2
+            bit.contact_velocity, bit.contact_depth, bit.contact_velocity / a)
+
+
 @njit(cache=True)
 def cutting_law(u, u_dot, omega, cut, slope, blades, zeta_eps_a, eps_a2_half, contact_force, torque_arm,
                 contact_velocity, contact_depth, spin_scale):
@@ -174,15 +184,8 @@ class CuttingBit:
 
     def _set_parameters(self, bit) -> None:
         self.blades = bit.blades
-        a = bit.bit_radius
-        self.cutting = (bit.cutting_orientation * bit.specific_energy * a, bit.specific_energy * a * a / 2.0)
-        self.contact_force = bit.contact_strength * a * bit.wear_flat_length  # sigma a l
-        self.contact_torque_arm = bit.friction * bit.geometry_factor * a / 2.0  # T_f = mu gamma a W_f / 2
-        self.contact_velocity, self.contact_depth = bit.contact_velocity, bit.contact_depth
-        self.spin_scale = bit.contact_velocity / a
         #: :func:`cutting_law`'s constants after the bit's state and the surface.
-        self.law_constants = (float(self.blades), *self.cutting, self.contact_force, self.contact_torque_arm,
-                              self.contact_velocity, self.contact_depth, self.spin_scale)
+        self.law_constants = cutting_law_constants(bit)
 
     @classmethod
     def chosen(cls, scene) -> bool:
