@@ -336,12 +336,14 @@ def cmd_stick_slip_map(args) -> int:
         print(f"  {controller}: stick-slip severity by weight on bit (rows, kN) and rotation speed (columns, rpm)")
         print("           " + "".join(f"{o * 30 / np.pi:8.0f}" for o in at.rotation_speed.values))
         for i, w in enumerate(at.weight_on_bit.values):
-            cells = [("   fail " if not np.isfinite(v) else f"{v:7.2f}" + ("*" if not s else " "))
-                     for v, s in zip(at.severity.values[i], at.settled.values[i])]
+            cells = [("   fail " if not np.isfinite(v) else f"{v:7.2f}" + ("!" if f else "*" if not s else " "))
+                     for v, s, f in zip(at.severity.values[i], at.settled.values[i], at.failed.values[i])]
             print(f"  {w / 1e3:8.1f} " + "".join(cells))
     if report["settled_points"] < report["points"]:
         print(f"  *: not settled within stick_slip_map.time_limit = {grid.attrs['time_limit_s']:g} s (its last "
               "windows reported)")
+    if report["failed_points"]:
+        print("  !: a step's Newton failed there even in halves (map.csv says when); the windows before it reported")
     return 0
 
 

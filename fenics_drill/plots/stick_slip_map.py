@@ -50,12 +50,14 @@ def stick_slip_map_figure(grid, path: Path) -> Path:
             mesh = ax.pcolormesh(_edges(rpm), _edges(weight), np.ma.masked_invalid(values), cmap=cmap,
                                  shading="flat", vmin=limits[name][0], vmax=limits[name][1])
             fig.colorbar(mesh, ax=ax)
+            failed = at["failed"].values if "failed" in at else np.zeros_like(unsettled)
             for i, j in zip(*np.nonzero(unsettled)):
-                ax.text(rpm[j], weight[i], "x", ha="center", va="center", color="grey")
+                ax.text(rpm[j], weight[i], "!" if failed[i, j] else "x", ha="center", va="center", color="grey")
             ax.set_xlabel("rotation speed [rpm]")
             ax.set_ylabel("weight on bit [kN]")
             ax.set_title(f"{controller}: {title}" if col == 0 else title, fontsize=9)
     fig.suptitle(f"stick-slip map ({grid.attrs.get('bit_rock_law', '')} bit law, {grid.attrs.get('drive_mode', '')} "
-                 f"drive; x: not settled within {grid.attrs.get('time_limit_s', 0):g} s)", fontsize=10)
+                 f"drive; x: not settled within {grid.attrs.get('time_limit_s', 0):g} s; !: a step failed, the "
+                 "windows before it shown)", fontsize=10)
     fig.tight_layout()
     return save_figure(fig, path)

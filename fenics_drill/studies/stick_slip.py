@@ -295,13 +295,19 @@ def limit_cycle(scene, time_limit: float, dt: float | None = None, simulation: S
     """Step the scene's string window by window (two first torsional periods each) until its steady rotation or
     its limit cycle has settled after the first :data:`TRANSIENT_WINDOWS` windows (:func:`settled_cycle`), or to
     ``time_limit`` [s]: the cycle's metrics (:func:`cycle_metrics`; at the limit, over the last
-    :data:`TRANSIENT_WINDOWS` windows), with ``settled``, the time run, the window and the step."""
+    :data:`TRANSIENT_WINDOWS` windows), with ``settled``, the time run, the window and the step.  A step whose Newton
+    fails ends the run there: ``failed`` says why, and the metrics are those of the windows before it (StepFailed
+    where there were none)."""
     simulation = start(scene, dt=dt) if simulation is None else simulation
     window = 2.0 * first_torsional_period(simulation.string)
     omega = scene.drive.rotation_speed
-    kind, rows = None, None
+    kind, rows, failed = None, None, None
     while simulation.time < time_limit - 1e-9:
-        simulation.run(min(window, time_limit - simulation.time))
+        try:
+            simulation.run(min(window, time_limit - simulation.time))
+        except StepFailed as err:  # reported with what was run before it
+            failed = str(err)
+            break
         if progress is not None:
             progress(simulation.time)
         if simulation.time >= (TRANSIENT_WINDOWS + 1) * window * (1.0 - 1e-9):  # a whole window past the transient
@@ -312,8 +318,11 @@ def limit_cycle(scene, time_limit: float, dt: float | None = None, simulation: S
                 break
     if kind is None:
         series = simulation.series()
+        if series["time"].size < 2:
+            raise StepFailed(failed)
         rows = _part(series, series["time"] > series["time"][-1] - TRANSIENT_WINDOWS * window)
     out = cycle_metrics(rows, omega, bit_area(scene), kind == "steady")
+    out["failed"] = failed
     steps, iterations, halved = (int(c) for c in simulation.counters)
     out.update(settled=kind is not None, time_s=simulation.time, window_s=window, dt_s=simulation.dt, steps=steps,
                newton_iterations_per_step=iterations / max(steps, 1), steps_halved=halved)

@@ -80,14 +80,14 @@ def _read_point(path: Path) -> dict:
 
 def run_point(scene, string, controller: str, weight_on_bit: float, rotation_speed: float) -> dict:
     """One point's cycle (:func:`~fenics_drill.studies.stick_slip.limit_cycle`), with its wall time; a point whose
-    Newton fails reports it (``failed``) with NaN metrics rather than ending the map."""
+    Newton fails reports it (``failed``), with the metrics of the windows before (NaN in its first), rather than
+    ending the map."""
     clock = time.perf_counter()
     point = point_scene(scene, controller, weight_on_bit, rotation_speed)
     try:
         simulation = start(point, string=pressed_for(string, point))
         out = limit_cycle(point, point.stick_slip_map.time_limit, simulation=simulation)
-        out["failed"] = None
-    except StepFailed as err:
+    except StepFailed as err:  # in the first window
         out = {name: float("nan") for name in REPORTED}
         out.update(settled=False, steady_rotation=False, failed=str(err))
     out["wall_time_s"] = time.perf_counter() - clock
@@ -144,12 +144,13 @@ def write_stick_slip_map(scene, out: str | Path, resume: bool = False, overwrite
 
 def _csv(points, results) -> str:
     header = ["controller", "weight_on_bit (N)", "rotation_speed (rad/s)", "settled", "steady_rotation"] + \
-        [f"{name} ({unit})" for name, unit in REPORTED.items()]
+        [f"{name} ({unit})" for name, unit in REPORTED.items()] + ["failed"]
     lines = [",".join(header)]
     for (controller, w, o), r in zip(points, results):
         values = [r.get(name) for name in REPORTED]
+        failed = (r.get("failed") or "").replace(",", ";")
         lines.append(",".join([controller, f"{w:.9g}", f"{o:.9g}", str(r["settled"]), str(r["steady_rotation"])]
-                              + ["" if v is None else f"{v:.9g}" for v in values]))
+                              + ["" if v is None else f"{v:.9g}" for v in values] + [f'"{failed}"' if failed else ""]))
     return "\n".join(lines) + "\n"
 
 
@@ -167,6 +168,7 @@ def _assembled(scene, results: list[dict], seconds: float, ranks: int) -> dict:
     dims = ("controller", "weight_on_bit", "rotation_speed")
     data = {name: (dims, field(name), {"units": unit}) for name, unit in REPORTED.items()}
     data["settled"] = (dims, field("settled").astype(bool))
+    data["failed"] = (dims, np.array([bool(r.get("failed")) for r in results]).reshape(shape))
     data["steady_rotation"] = (dims, field("steady_rotation").astype(bool))
     dataset = xr.Dataset(data, coords={"controller": list(m.controllers),
                                        "weight_on_bit": ("weight_on_bit", weights, {"units": "N"}),
