@@ -28,6 +28,7 @@ from petsc4py import PETSc
 from fenics_drill.forms import energies
 from fenics_drill.model.kernels.banded_saddle import SparseSum
 from fenics_drill.model.kernels.cell_kernels import CellAssembly
+from fenics_drill.model.kernels.compiled import form as compiled_form
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.operators import LinearOperators
 from fenics_drill.model.kernels.packed_rows import FieldPackedRows
@@ -122,14 +123,14 @@ class InternalForms:
             remainders = [force(True) - force(False) for force, on in ((inertial, inertial_nonlinearity),
                                                                         (elastic, geometric_nonlinearity)) if on]
             residual = sum(remainders[1:], remainders[0])
-        self.kinetic = fem.form(energy(kinetic, energies.kinetic_energy_density(p, U, V, False)))
-        self.strain = fem.form(energy(strain, energies.strain_energy_density(p, energies.strain_slots(U, p.axis), False)))
-        self.residual = fem.form(residual)
+        self.kinetic = compiled_form(energy(kinetic, energies.kinetic_energy_density(p, U, V, False)))
+        self.strain = compiled_form(energy(strain, energies.strain_energy_density(p, energies.strain_slots(U, p.axis), False)))
+        self.residual = compiled_form(residual)
         # one form per derivative df/dq, df/dqd, df/dqdd (None where the residual does not hold the field): each
         # part is assembled by a kernel of its own, not by the whole Jacobian's kernel with two coefficients zero.
         # Which fields it holds is read off the form, not by expanding the derivatives (0.2 s of UFL per string)
         held = set(residual.coefficients())
-        self.jacobians = tuple(fem.form(ufl.derivative(residual, field, dU)) if field in held else None
+        self.jacobians = tuple(compiled_form(ufl.derivative(residual, field, dU)) if field in held else None
                                for field in (U, V, A))
 
     @classmethod

@@ -13,6 +13,7 @@ from dolfinx import fem
 from petsc4py import PETSc
 
 from fenics_drill.model.discretization import BeamDiscretization
+from fenics_drill.model.kernels.compiled import form as compiled_form
 from fenics_drill.forms import damping_form, geometric_stiffness_form, gravity_form, mass_form, stiffness_form
 
 
@@ -37,10 +38,10 @@ def _forms(disc: BeamDiscretization):
     dx = ufl.Measure("dx", domain=disc.mesh)
     p, numbers = disc.form_properties, disc.properties  # what the forms take; the switches read numbers
     return (
-        fem.form(mass_form(p, psi, U, dx)),
-        fem.form(damping_form(p, psi, U, dx)) if numbers.damping != 0 or numbers.lateral_fluid_damping != 0 else None,
-        fem.form(stiffness_form(p, psi, U, dx)),
-        fem.form(gravity_form(p, psi, dx)) if numbers.gravity != 0 else None,  # g = 0: UFL's zero form
+        compiled_form(mass_form(p, psi, U, dx)),
+        compiled_form(damping_form(p, psi, U, dx)) if numbers.damping != 0 or numbers.lateral_fluid_damping != 0 else None,
+        compiled_form(stiffness_form(p, psi, U, dx)),
+        compiled_form(gravity_form(p, psi, dx)) if numbers.gravity != 0 else None,  # g = 0: UFL's zero form
     )
 
 
@@ -70,7 +71,7 @@ def assemble_geometric_stiffness(disc: BeamDiscretization, displacement: np.ndar
     state.x.array[:] = displacement
     U, psi = ufl.TrialFunction(disc.V), ufl.TestFunction(disc.V)
     dx = ufl.Measure("dx", domain=disc.mesh)
-    A = fem_petsc.assemble_matrix(fem.form(geometric_stiffness_form(disc.form_properties, psi, U, state, dx)))
+    A = fem_petsc.assemble_matrix(compiled_form(geometric_stiffness_form(disc.form_properties, psi, U, state, dx)))
     A.assemble()
     return petsc_to_scipy(A)
 

@@ -25,6 +25,7 @@ import ufl
 from dolfinx import fem
 
 from fenics_drill.model.discretization import THETA_X, BeamDiscretization
+from fenics_drill.model.kernels.compiled import form as compiled_form
 from fenics_drill.forms import FIELD_NAMES, mass_form
 from fenics_drill.forms.energies import inertial_force, strain_energy_gradient_terms, strain_slots
 from fenics_drill.forms.printed import (
@@ -65,15 +66,15 @@ def random_state(disc: BeamDiscretization, seed: int, scale: float = 0.05, rotat
 
 
 def _relative_l2(a, b, dx) -> float:
-    diff = fem.assemble_scalar(fem.form((a - b) ** 2 * dx))
-    ref = fem.assemble_scalar(fem.form(b**2 * dx))
+    diff = fem.assemble_scalar(compiled_form((a - b) ** 2 * dx))
+    ref = fem.assemble_scalar(compiled_form(b**2 * dx))
     return float(np.sqrt(diff / ref)) if ref > 0 else float(np.sqrt(diff))
 
 
 def _vector_parts(form, disc: BeamDiscretization) -> list[np.ndarray]:
     import dolfinx.fem.petsc as fem_petsc
 
-    vec = fem_petsc.assemble_vector(fem.form(form))
+    vec = fem_petsc.assemble_vector(compiled_form(form))
     return [vec.array[dofs].copy() for dofs in disc.field_dofs]
 
 

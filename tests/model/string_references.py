@@ -12,17 +12,22 @@ import scipy.linalg
 import scipy.optimize
 
 
-def rod_transfer(segments, omega: float) -> np.ndarray:
+def rod_transfer(segments, omega):
     """The transfer matrix of the state (displacement, force) from the top of a rod to its bottom, at the circular
-    frequency ``omega``: the product of each uniform segment's [[cos kl, sin kl / (S k)], [-S k sin kl, cos kl]],
-    k = omega sqrt(m / S).  ``segments``: (length [m], stiffness S [N or N m^2], inertia m [kg/m or kg m]) from
-    the top down; the wave equation S y'' = m y_tt in each, y and S y' continuous between them."""
-    matrix = np.eye(2)
+    frequency ``omega`` (a number, or an array: one matrix per frequency): the product of each uniform segment's
+    [[cos kl, sin kl / (S k)], [-S k sin kl, cos kl]], k = omega sqrt(m / S).  ``segments``: (length [m],
+    stiffness S [N or N m^2], inertia m [kg/m or kg m]) from the top down; the wave equation S y'' = m y_tt in
+    each, y and S y' continuous between them."""
+    omegas = np.atleast_1d(np.asarray(omega, dtype=float))
+    matrix = np.broadcast_to(np.eye(2), (omegas.size, 2, 2)).copy()
+    segment = np.empty_like(matrix)
     for length, stiffness, inertia in segments:
-        k = omega * math.sqrt(inertia / stiffness)
-        c, s = math.cos(k * length), math.sin(k * length)
-        matrix = np.array([[c, s / (stiffness * k)], [-stiffness * k * s, c]]) @ matrix
-    return matrix
+        k = omegas * math.sqrt(inertia / stiffness)
+        c, s = np.cos(k * length), np.sin(k * length)
+        segment[:, 0, 0], segment[:, 0, 1], segment[:, 1, 0], segment[:, 1, 1] = c, s / (stiffness * k), \
+            -stiffness * k * s, c
+        matrix = segment @ matrix
+    return matrix if np.ndim(omega) else matrix[0]
 
 
 #: The entry of the transfer matrix that vanishes at a natural frequency, for each (top, bottom) condition:
@@ -41,7 +46,7 @@ def rod_frequencies(segments, top: str, bottom: str, count: int, highest_hz: flo
         return rod_transfer(segments, 2.0 * math.pi * f)[row, column]
 
     grid = np.linspace(1e-6 * highest_hz, highest_hz, 40000)
-    values = np.array([entry(f) for f in grid])
+    values = rod_transfer(segments, 2.0 * math.pi * grid)[:, row, column]
     # Brent's method to the last bits of the root (frequencies of order 1-100 Hz): the reference must be exact far
     # below the 1e-4 the FE is held to
     roots = [scipy.optimize.brentq(entry, a, b, xtol=1e-14, rtol=1e-15)

@@ -8,6 +8,12 @@ function (cached on disk, so a process pays the compilation once per install) an
 wrapper that raises the interrupt as what it is.  Kernels called only from other kernels need
 ``numba.njit(cache=True)`` alone: the wrapper is for the ones Python calls.
 
+Compiling is never cut short.  A signal that arrives while FFCx compiles a form or Numba compiles a kernel
+(:func:`compiling`) is held until the compiler is done and then delivered as it came: FFCx cut by
+KeyboardInterrupt leaves its cache holding a form that never finishes compiling (every later process waits for
+it and fails), and Numba cut inside its cache writer fails with an unrelated RuntimeError.  A form whose cache
+entry was left so by a process killed outright (SIGKILL) is compiled afresh (:func:`form`).
+
 Numba keeps a kernel's compiled code on disk (``__pycache__``) until its own file changes, not when a kernel it
 calls from another file does: after editing a kernel that kernels of other files call (the laws and passes that
 ``solvers/compiled_residual.py`` and ``solvers/compiled_step.py`` call, ``cell_kernels.tabulate_at_cells``), touch
@@ -16,9 +22,56 @@ those files or delete their ``__pycache__`` directories, or they run the old cod
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import re
+import signal
+import threading
+from pathlib import Path
 
 from numba import njit
+
+#: The signals a command stops on (Ctrl-C, a batch system's SIGTERM), held while compiling.
+HELD_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+@contextlib.contextmanager
+def compiling():
+    """A block in which SIGINT and SIGTERM are held: each arrives as it came, to the handler that was in place,
+    once the block ends (a no-op outside the main thread, where Python runs no handlers)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    arrived: list[int] = []
+    previous = {s: signal.signal(s, lambda signum, frame: arrived.append(signum)) for s in HELD_SIGNALS}
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        for signum in dict.fromkeys(arrived):
+            signal.raise_signal(signum)
+
+
+#: FFCx's word for a form whose cache entry another process began and never finished.
+_STALE_ENTRY = re.compile(r"remove (\S+\.c)\)")
+
+
+def form(ufl_form, **options):
+    """``dolfinx.fem.form`` compiled whole (:func:`compiling`); a cache entry left unfinished by a killed process
+    is set aside (as FFCx sets aside a failed one) and the form compiled afresh."""
+    from dolfinx import fem
+
+    with compiling():
+        try:
+            return fem.form(ufl_form, **options)
+        except TimeoutError as error:
+            stale = _STALE_ENTRY.search(str(error))
+            if stale is None or not Path(stale.group(1)).exists():
+                raise
+            path = Path(stale.group(1))
+            path.replace(path.with_suffix(".c.failed"))
+            return fem.form(ufl_form, **options)
 
 
 def interrupt_in(error: BaseException) -> KeyboardInterrupt | None:
@@ -47,6 +100,9 @@ def kernel(function=None, *, fastmath=False):
     @functools.wraps(function)
     def call(*args):
         try:
+            if not compiled.signatures:  # its first call in this process compiles it, or loads it from the cache
+                with compiling():
+                    return compiled(*args)
             return compiled(*args)
         except SystemError as error:
             if interrupt_in(error) is None:

@@ -43,6 +43,7 @@ from dolfinx import fem
 
 from fenics_drill.forms import energies
 from fenics_drill.model.discretization import THETA_X, U, V, W, BeamDiscretization
+from fenics_drill.model.kernels.compiled import form as compiled_form
 from fenics_drill.model.operators import LinearOperators
 
 
@@ -183,7 +184,7 @@ def axial_companions(disc: BeamDiscretization, statics: StaticSolver, vectors: n
     dx = ufl.Measure("dx", domain=disc.mesh, metadata={"quadrature_degree": 2 * disc.element_degree})
     zero, direction = fem.Function(disc.V), fem.Function(disc.V)
     force = energies.elastic_force(p, ufl.TestFunction(disc.V), zero, dx, True, kinematics)
-    second = fem.form(ufl.derivative(ufl.derivative(force, zero, direction), zero, direction))
+    second = compiled_form(ufl.derivative(ufl.derivative(force, zero, direction), zero, direction))
     loads = np.zeros((disc.ndofs, vectors.shape[1]))
     for i, phi in enumerate(vectors.T):
         direction.x.array[:] = phi
