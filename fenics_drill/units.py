@@ -127,6 +127,7 @@ def _normalised(text: str) -> str:
 
 
 _DIGITS = re.compile(r"\d+")
+_PLAIN_DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 _EXPONENT = re.compile(r"[eE][+-]?\d+")
 _MIXED = re.compile(r"(?P<whole>\d+)(?: +|-)(?P<num>\d+) */ *(?P<den>\d+)(?![\d.,/])")
 _FRACTION = re.compile(r"(?P<num>\d+) */ *(?P<den>\d+)(?![\d.,/])")
@@ -220,6 +221,8 @@ def read_number(text: str, decimal_comma: bool = False) -> float:
     """A plain number as written in the field (``"5 000"``, ``"0,3"``, ``"1/2"``, ``"-12.5"``); UnitError where
     it is ambiguous, not a number, or written with a unit.  ``decimal_comma``: a comma is the decimal separator (a
     file whose fields are separated by semicolons or tabs)."""
+    if isinstance(text, str) and _PLAIN_DECIMAL.fullmatch(text.strip()):
+        return float(text)  # the common case, read as Python reads it (a survey file's thousands of stations)
     written = _normalised(str(text))
     if decimal_comma and "." not in written:
         written = written.replace(",", ".")

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import functools
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -193,7 +195,13 @@ def read_survey_csv(path: Path) -> Survey:
     line; commas, semicolons or tabs between the fields (with semicolons or tabs, a decimal comma is read); lines
     starting with # and blank lines are skipped.  Errors name the file and the line; the columns left out are in
     the survey's ``notes``."""
-    lines = [(k, line) for k, line in enumerate(_survey_text(path).splitlines(), start=1)
+    return _parsed_survey(path, _survey_text(path))
+
+
+@functools.lru_cache(maxsize=8)
+def _parsed_survey(path: Path, text: str) -> Survey:
+    """:func:`read_survey_csv` of ``text`` read from ``path`` (kept: a command reads its survey at every stage)."""
+    lines = [(k, line) for k, line in enumerate(text.splitlines(), start=1)
              if line.strip() and not line.lstrip().startswith("#")]
     if not lines:
         raise SurveyError(f"survey file {path} holds no stations")
@@ -294,10 +302,7 @@ class Trajectory:
         binormals = np.cross(self.t[:-1], self.t[1:])
         norms = np.linalg.norm(binormals, axis=1)
         binormals = np.where(norms[:, None] > 1e-12, binormals / np.where(norms > 1e-12, norms, 1.0)[:, None], 0.0)
-        d3 = [_high_side(self.t[0], self.survey.azimuth[0])]
-        for k, beta in enumerate(self.beta):  # the frame at each station, carried along the arcs
-            d3.append(_rotated(d3[-1], binormals[k], beta)[0])
-        d3 = np.array(d3)
+        d3 = _carried(_high_side(self.t[0], self.survey.azimuth[0]), binormals, self.beta)
         k = self._segment(s)
         share = np.clip((s - self.md[k]) / (self.md[k + 1] - self.md[k]), 0.0, 1.0)
         t = self.tangents(s)
@@ -333,6 +338,21 @@ def _high_side(t: np.ndarray, azimuth: float) -> np.ndarray:
     if norm > 1e-9:
         return up / norm
     return np.array([np.cos(azimuth), np.sin(azimuth), 0.0])
+
+
+def _carried(start: np.ndarray, axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """``start`` and its images as each arc turns it in turn by ``angles`` about ``axes`` (rows): the frame's
+    vector at every station (Rodrigues' rotation, one station after the other in plain floats: a survey may have
+    tens of thousands)."""
+    x, y, z = (float(c) for c in start)
+    out = [(x, y, z)]
+    for (a, b, c), angle in zip(axes.tolist(), np.asarray(angles, dtype=float).tolist()):
+        cos, sin = math.cos(angle), math.sin(angle)
+        along = (a * x + b * y + c * z) * (1.0 - cos)
+        x, y, z = (x * cos + (b * z - c * y) * sin + a * along, y * cos + (c * x - a * z) * sin + b * along,
+                   z * cos + (a * y - b * x) * sin + c * along)
+        out.append((x, y, z))
+    return np.array(out)
 
 
 def _rotated(vectors: np.ndarray, axes: np.ndarray, angles) -> np.ndarray:
