@@ -5,7 +5,7 @@
 * Cost per simulated second of the compiled steps (after a first second that compiles and starts), in seconds and in
   machine units (one LAPACK banded LU and solve of benchmarks/speed.py, timed in this process before and after),
   with Newton iterations per step and the steps halved.
-* The 2000 m vertical string of demos/scenes/vertical_2000m.toml to its limit cycle (or 200 s).
+* The 2000 m vertical string of demos/scenes/vertical_2000m.toml to its limit cycle (or 200 s) at four points.
 * The limit cycle of the build-and-hold demo well at 20 kN and 60 rpm against the element length and the step.
 """
 
@@ -37,6 +37,9 @@ COSTS = (
     ("2000 m vertical (cutting law, hook load 60 kN, 60 rpm), 10 m elements", VERTICAL, ("beam.elements=200",), 20.0),
 )
 
+#: (weight on bit [kN], rotation speed [rpm]) of the 2000 m string: its scene's point, below and above 60 rpm.
+VERTICAL_POINTS = ((60, 60), (45, 60), (45, 100), (60, 120))
+
 
 def cost(path, settings, seconds):
     simulation = start(fd.load_scene(path, list(settings)))
@@ -55,9 +58,12 @@ def main() -> None:
              f"`python benchmarks/stick_slip_speed.py`. Machine: {platform.machine()}, {os.cpu_count()} cores "
              f"({processor()}), Python {platform.python_version()}; one process.", ""]
     rows = [cost(path, settings, seconds) for _, path, settings, seconds in COSTS]
-    clock = time.perf_counter()
-    vertical = limit_cycle(fd.load_scene(VERTICAL, ["beam.elements=200"]), 200.0)
-    vertical_wall = time.perf_counter() - clock
+    verticals = []
+    for wob, rpm in VERTICAL_POINTS:
+        clock = time.perf_counter()
+        cycle = limit_cycle(fd.load_scene(VERTICAL, ["beam.elements=200", f"drive.weight_on_bit='{wob} kN'",
+                                                     f"drive.rotation_speed='{rpm} rpm'"]), 200.0)
+        verticals.append((wob, rpm, cycle, time.perf_counter() - clock))
     convergence = []
     for label, settings, dt_share in (("20 m elements", ("beam.elements=45",), 1.0),
                                       ("10 m elements", ("beam.elements=90",), 1.0),
@@ -74,12 +80,14 @@ def main() -> None:
     for (name, *_), (per_second, iterations, halved, size, dt) in zip(COSTS, rows):
         lines.append(f"| {name} | {size} | {dt * 1e3:.2f} | {per_second:.3f} | {per_second / unit:.1f} | "
                      f"{iterations:.2f} | {halved} |")
-    v = vertical
-    lines += ["", f"The 2000 m vertical string to its limit cycle: {'settled' if v['settled'] else 'not settled'} "
-              f"after {v['time_s']:.1f} s of drilling in {vertical_wall:.1f} s of wall time; severity "
-              f"{v['severity']:.3f}, period {v['period_s'] or 0:.3f} s, stuck {v['stuck_share']:.3f} of the time, "
-              f"bit spin {v['min_bit_spin_rad_s']:.2f} to {v['max_bit_spin_rad_s']:.2f} rad/s.", "",
-              "The build-and-hold well's limit cycle at 20 kN and 60 rpm (cutting law, hook load):", "",
+    lines += ["", "The 2000 m vertical string (10 m elements, cutting law, hook load) to its limit cycle or 200 s:", "",
+              "| weight on bit [kN] | rotation speed [rpm] | settled | drilled [s] | wall [s] | severity | period [s] "
+              "| stuck share | bit spin [rad/s] |", "|---|---|---|---|---|---|---|---|---|"]
+    for wob, rpm, v, wall in verticals:
+        lines.append(f"| {wob} | {rpm} | {'yes' if v['settled'] else 'no'} | {v['time_s']:.1f} | {wall:.1f} | "
+                     f"{v['severity']:.3f} | {v['period_s'] or 0:.3f} | {v['stuck_share']:.3f} | "
+                     f"{v['min_bit_spin_rad_s']:.2f} to {v['max_bit_spin_rad_s']:.2f} |")
+    lines += ["", "The build-and-hold well's limit cycle at 20 kN and 60 rpm (cutting law, hook load):", "",
               "| mesh and step | step [ms] | settled after [s] | severity | period [s] | stuck share "
               "| surface torque [N m] | rop [m/h] |", "|---|---|---|---|---|---|---|---|"]
     for label, c in convergence:
