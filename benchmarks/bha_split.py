@@ -3,9 +3,9 @@ law, the drawworks holding 40 kN on the bit, 60 rpm) with the lateral fields ove
 (``model.lateral_length = -1``), over the bottom 150 m (the collars and the heavy-weight pipe) and nowhere (0), each
 by ``fenics-drill run``; the means over the second second of what a drilling engineer reads, and each run's wall time.
 
-    python benchmarks/bha_split.py [--t-end 2] [--lengths -1,150,0]
+    python benchmarks/bha_split.py [--t-end 2] [--lengths=-1,150,0] [--set KEY=VALUE ...] [--name bha_split]
 
-writes benchmarks/results/bha_split.md.
+writes benchmarks/results/NAME.md.
 """
 
 from __future__ import annotations
@@ -29,8 +29,8 @@ from speed import machine_unit, processor  # noqa: E402
 SCENE = "demos/scenes/well_build_hold.toml"
 
 
-def measured(length: float, t_end: float) -> dict:
-    scene = fd.load_scene(SCENE, [f"model.lateral_length={length}", f"time.t_end={t_end}",
+def measured(length: float, t_end: float, settings: list[str]) -> dict:
+    scene = fd.load_scene(SCENE, [*settings, f"model.lateral_length={length}", f"time.t_end={t_end}",
                                   "output.field_interval=0"])
     with tempfile.TemporaryDirectory() as out:
         clock = time.perf_counter()
@@ -57,11 +57,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--t-end", type=float, default=2.0)
     parser.add_argument("--lengths", default="-1,150,0")
+    parser.add_argument("--set", action="append", default=[], dest="settings", help="a scene setting, KEY=VALUE")
+    parser.add_argument("--name", default="bha_split", help="the results file's name")
     args = parser.parse_args()
     unit = machine_unit()
-    rows = [(float(length), measured(float(length), args.t_end)) for length in args.lengths.split(",")]
+    rows = [(float(length), measured(float(length), args.t_end, args.settings)) for length in args.lengths.split(",")]
+    written = "".join(f" --set \"{setting}\"" for setting in args.settings)
     lines = ["# The BHA split against the whole string", "",
-             f"`python benchmarks/bha_split.py --t-end {args.t_end:g} --lengths {args.lengths}`. Machine: "
+             f"`python benchmarks/bha_split.py --t-end {args.t_end:g} --lengths={args.lengths}{written} --name "
+             f"{args.name}`. Machine: "
              f"{platform.machine()}, {os.cpu_count()} cores ({processor()}), Python {platform.python_version()}; one "
              f"process; machine unit (benchmarks/speed.py) {unit * 1e3:.1f} ms.", "",
              f"{SCENE} on bottom, means over the second half of {args.t_end:g} s:", "",
@@ -73,7 +77,7 @@ def main() -> None:
                      f"{r['surface_torque_kN_m']:.3f} | {r['weight_on_bit_kN']:.2f} | {r['bit_spin_mean']:.3f} | "
                      f"{r['bit_spin_min']:.2f} to {r['bit_spin_max']:.2f} | {r['rop_m_h']:.2f} |")
     text = "\n".join(lines) + "\n"
-    Path("benchmarks/results/bha_split.md").write_text(text)
+    Path(f"benchmarks/results/{args.name}.md").write_text(text)
     print(text)
 
 
