@@ -38,7 +38,7 @@ demo-as-printed: setup
 reproduction: setup
 	$(PY) benchmarks/reproduction.py --ranks $(RANKS)
 
-## The test suite (12 minutes on 2 cores, AMD EPYC, Python 3.13: pytest reported 727 s).
+## The test suite (12 minutes on 2 cores, AMD EPYC, Python 3.13: pytest reported 703 s).
 test: setup
 	$(PY) -m pytest -q tests
 
