@@ -7,6 +7,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from fenics_drill.model.kernels.compiled import kernel
+
 
 @njit(cache=True, inline="always")
 def _return_map(normal_force, held_axial, held_tangential, axial_slip, tangential_slip, friction, stick_stiffness):
@@ -27,12 +29,22 @@ def coulomb_friction(normal_force, held_axial, held_tangential, axial_slip, tang
                      stick_stiffness):
     """One Coulomb force at the contact point, by return mapping (:func:`_return_map`): (F_a, F_t) with
     |F| <= mu |F_n|, the stuck contact's spring k_t below it and the cone's surface, opposing the trial's slip,
-    above."""
-    return _COULOMB(normal_force, held_axial, held_tangential, axial_slip, tangential_slip, friction,
-                    stick_stiffness)[:2]
+    above; the arguments broadcast as NumPy's arrays do."""
+    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (normal_force, held_axial, held_tangential,
+                                                                          axial_slip, tangential_slip)))
+    flat = [np.ascontiguousarray(a).ravel() for a in arrays]
+    axial, tangential = _return_maps(*flat, float(friction), float(stick_stiffness))
+    return axial.reshape(arrays[0].shape), tangential.reshape(arrays[0].shape)
 
 
-_COULOMB = np.vectorize(_return_map, otypes=(float, float, float))
+@kernel
+def _return_maps(normal_force, held_axial, held_tangential, axial_slip, tangential_slip, friction, stick_stiffness):
+    """:func:`_return_map` at each entry of the arrays."""
+    axial, tangential = np.empty(normal_force.size), np.empty(normal_force.size)
+    for i in range(normal_force.size):
+        axial[i], tangential[i], _ = _return_map(normal_force[i], held_axial[i], held_tangential[i], axial_slip[i],
+                                                 tangential_slip[i], friction, stick_stiffness)
+    return axial, tangential
 
 
 @njit(cache=True, inline="always")
