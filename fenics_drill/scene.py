@@ -217,6 +217,9 @@ class Model:
                        "docs/errata.md)", choices=("st_venant", "printed"))
     lateral_length: float = key(-1.0, "length above the bit whose lateral fields are solved; -1: all, 0: none [m]",
                                 lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for the whole string)")
+    axial_torsional_element_length: float = key(
+        -1.0, "element length above the lateral length, where only u and theta_x are solved; -1: as below it "
+        "(beam.elements over the string) [m]", lambda x: x == -1.0 or x > 0, "> 0 (or -1 for the lateral part's)")
 
 
 def _positions(x) -> bool:
@@ -788,6 +791,10 @@ def _check_relations(scene: Scene) -> Scene:
     if scene.model.lateral_length > length * (1 + 1e-12):
         raise SceneError(f"model.lateral_length = {scene.model.lateral_length!r} is not admissible: must be <= the "
                          f"string's length, {length!r} m (or -1 for the whole string)")
+    if scene.model.axial_torsional_element_length > 0 and scene.model.lateral_length < 0:
+        raise SceneError(f"model.axial_torsional_element_length = {scene.model.axial_torsional_element_length!r} is "
+                         "not admissible with model.lateral_length = -1: the whole string carries its lateral fields "
+                         "(set model.lateral_length to the length above the bit that needs them, or 0)")
     contact = scene.contact
     if contact.friction_model == "coulomb":
         for name in ("axial_friction_law", "friction_torque_law"):

@@ -49,15 +49,21 @@ def field_degrees(element_degree: int) -> tuple[int, ...]:
     return (k, k, k, k - 1, k - 1, k - 1)
 
 
-def mesh_vertices(length: float, elements: int, breaks) -> np.ndarray:
+def mesh_vertices(length: float, elements: int, breaks, coarse: tuple[float, float] | None = None) -> np.ndarray:
     """Vertices on [0, length] about ``length / elements`` apart that fall on every break inside it: each interval
     between consecutive breaks is cut into equal elements no longer than that (so there are at least
-    ``elements``)."""
+    ``elements``).  ``coarse`` = (x_top, h): the intervals above x_top (which must be a break) into elements no
+    longer than h instead."""
     h = length / elements
     points = np.unique(np.clip(np.array([0.0, length, *breaks], dtype=float), 0.0, length))
     points = points[np.concatenate([[True], np.diff(points) > 1e-9 * length])]  # breaks closer than round-off: one
     points[-1] = length
-    pieces = [np.linspace(a, b, max(1, math.ceil((b - a) / h - 1e-9)) + 1)[:-1] for a, b in zip(points[:-1], points[1:])]
+
+    def spacing(b):
+        return coarse[1] if coarse is not None and b <= coarse[0] * (1 + 1e-12) else h
+
+    pieces = [np.linspace(a, b, max(1, math.ceil((b - a) / spacing(b) - 1e-9)) + 1)[:-1]
+              for a, b in zip(points[:-1], points[1:])]
     return np.concatenate([*pieces, [length]])
 
 
@@ -66,7 +72,7 @@ class BeamDiscretization:
 
     def __init__(self, properties: BeamProperties, elements: int, element_degree: int = 2, supports: str = "paper",
                  stabilisers: tuple = (), trajectory: Trajectory | None = None, sections=None, breaks: tuple = (),
-                 lateral_length: float = -1.0):
+                 lateral_length: float = -1.0, axial_torsional_element_length: float = -1.0):
         """``stabilisers``: x of pinned lateral supports inside the string (v = w = 0 at the nearest vertex);
         ``trajectory``: the well's axis the string lies along from its top (x = measured depth), or None for the
         straight horizontal hole; ``sections``: None for one pipe (``properties``), or what the string is made of
@@ -74,7 +80,9 @@ class BeamDiscretization:
         (``properties`` then holds the section at the bit, for what needs one number); ``breaks``: x where a
         vertex must fall (the ends of sections and of the survey's arcs: :func:`mesh_vertices`);
         ``lateral_length``: the length above the bit over which v, w, theta_y and theta_z are solved (-1: the whole
-        string; 0: none, an axial-torsional string): above it they are held at zero (:attr:`lateral_held_dofs`)."""
+        string; 0: none, an axial-torsional string): above it they are held at zero (:attr:`lateral_held_dofs`);
+        ``axial_torsional_element_length``: the elements' length there, if > 0 (else ``properties.length /
+        elements``, as below it)."""
         if supports not in SUPPORTS:
             raise ValueError(f"unknown supports {supports!r}; expected one of {', '.join(SUPPORTS)}")
         self.element_degree = element_degree
@@ -82,8 +90,12 @@ class BeamDiscretization:
         self.stabilisers = tuple(stabilisers)
         self.lateral_length = lateral_length
         self.comm = MPI.COMM_SELF
+        coarse = None
+        if axial_torsional_element_length > 0 and lateral_length >= 0:
+            top = properties.length - lateral_length
+            coarse, breaks = (top, axial_torsional_element_length), (*breaks, top)
         if breaks:
-            x = mesh_vertices(properties.length, elements, breaks)
+            x = mesh_vertices(properties.length, elements, breaks, coarse)
             cells = np.stack([np.arange(x.size - 1), np.arange(1, x.size)], axis=1).astype(np.int64)
             line = ufl.Mesh(basix.ufl.element("Lagrange", "interval", 1, shape=(1,)))
             self.mesh = mesh.create_mesh(self.comm, cells, line, x[:, None])
@@ -178,10 +190,10 @@ class BeamDiscretization:
         is the string's) in the hole sections of ``[well]``."""
         check_memory(scene.beam.elements, scene.beam.element_degree)
         sectioned = bool(scene.string.sections or scene.well.hole_radius)
-        lateral = scene.model.lateral_length
+        lateral, coarse = scene.model.lateral_length, scene.model.axial_torsional_element_length
         if not (sectioned or scene.well.survey or scene.well.md):
             return cls(scene.beam_properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports,
-                       scene.supports.stabilisers, lateral_length=lateral)
+                       scene.supports.stabilisers, lateral_length=lateral, axial_torsional_element_length=coarse)
         strings = string_sections(scene)
         well = well_of(scene, strings[-1].bottom)
         properties = replace(scene.beam_properties, length=strings[-1].bottom)
@@ -194,7 +206,7 @@ class BeamDiscretization:
         top = (strings[-1].bottom - lateral,) if lateral > 0 else ()  # a vertex at the lateral length's top
         breaks = (*(s.bottom for s in strings), *well.hole.bottoms, *stations, *top)
         return cls(properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports,
-                   scene.supports.stabilisers, trajectory, layout, breaks, lateral)
+                   scene.supports.stabilisers, trajectory, layout, breaks, lateral, coarse)
 
     @property
     def ndofs(self) -> int:

@@ -8,7 +8,7 @@ import pytest
 
 from axial_torsional_references import steady_rotation_references
 from string_references import rod_frequencies
-from test_modes_in_the_well import COLLAR, HEAVY_WEIGHT, PIPE, segments, vertical_string
+from test_modes_in_the_well import COLLAR, HEAVY_WEIGHT, PIPE, G, RHO, segments, vertical_string
 
 import fenics_drill as fd
 from fenics_drill.cli import main
@@ -148,3 +148,46 @@ def test_the_bha_split_drills_the_build_and_hold_well_as_the_whole_string_does_o
     assert split["weight_on_bit"] == pytest.approx(whole["weight_on_bit"], rel=0.01)
     assert split["spin"] == pytest.approx(whole["spin"], rel=0.02)
     assert split["rop"] == pytest.approx(whole["rop"], rel=0.03)
+
+
+def test_the_elements_above_the_lateral_length_take_their_own_length():
+    """``model.axial_torsional_element_length``: on the build-and-hold well with 150 m of lateral length and 900
+    elements (1 m), the vertices below the lateral length's top stay 1 m apart, those above are at most 10 m apart and
+    still fall on every section end and survey station; -1 leaves the mesh as it was; with the whole string's
+    lateral fields it is refused."""
+    scene = fd.load_scene("demos/scenes/well_build_hold.toml", ["beam.elements=900", "model.lateral_length=150.0"])
+    fine = BeamDiscretization.from_scene(scene).vertex_x
+    graded = BeamDiscretization.from_scene(scene.with_changes(model={"axial_torsional_element_length": 10.0})).vertex_x
+    np.testing.assert_array_equal(graded[graded >= 750.0], fine[fine >= 750.0])
+    above = graded[graded <= 750.0]
+    assert np.diff(above).max() <= 10.0 + 1e-9 and above.size < 80
+    stations = np.loadtxt("demos/scenes/well_build_hold_survey.csv", delimiter=",", skiprows=3)[:, 0]
+    for x in [*stations[stations <= 750.0], 0.0, 750.0]:  # the stations above, the top of the drill pipe and the string
+        assert np.min(np.abs(above - x)) < 1e-9
+    assert main(["scene", "demos/scenes/well_build_hold.toml", "--set", "model.axial_torsional_element_length=10"]) == 2
+
+
+def test_coarse_axial_torsional_elements_keep_the_strings_modes_within_their_discretisation_error():
+    """The axial-torsional string of the modes test (500 m: collar, heavy-weight and drill pipe hanging in a vertical
+    well, drive-held) meshed with 10 m elements: its first three axial and torsional frequencies against the exact
+    roots of the composite rod, within the discretisation error of the linear theta_x at h = 10 m: the dispersion of
+    linear elements with a consistent mass on a uniform rod, omega_h = (c / h) sqrt(6 (1 - cos kh) / (2 + cos kh))
+    (about (kh)^2 / 24), at the third torsional mode, with 1 % for the sections' joins (u is quadratic: far smaller);
+    and no closer than half of it, so that the test sees the coarse mesh at all."""
+    sections = [COLLAR, HEAVY_WEIGHT, PIPE]
+    scene = vertical_string(sections, 1000, "model.lateral_length=0.0", "model.axial_torsional_element_length=10.0")
+    disc = BeamDiscretization.from_scene(scene)
+    assert np.diff(disc.vertex_x).max() <= 10.0 + 1e-9
+    basis = solve_modes(disc, 2.0, assemble_linear(disc).mass, held=DRIVE, vectors=False)
+    errors = {}
+    for kind in ("axial", "torsional"):
+        fe = basis.frequencies_hz[np.array(basis.kinds) == kind][:3]
+        exact = rod_frequencies(segments(sections, kind), "held", "free", 3, 1.2 * fe[-1])
+        errors[kind] = np.abs(fe / exact - 1.0)
+        if kind == "torsional":
+            wave_speed = math.sqrt(G / RHO)
+            kh = 2 * math.pi * exact[-1] / wave_speed * 10.0
+            bound = 1.01 * (math.sqrt(6 * (1 - math.cos(kh)) / (2 + math.cos(kh))) / kh - 1.0)
+    assert errors["torsional"].max() <= bound
+    assert errors["torsional"].max() >= 0.5 * bound
+    assert errors["axial"].max() <= bound
