@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import shlex
 import sys
 import tempfile
 import time
@@ -89,7 +90,7 @@ def main() -> None:
     for length in args.lengths.split(","):
         rows.append((float(length), measured(args.scene, float(length), args.t_end, args.settings)))
         print(length, rows[-1], flush=True)
-    written = "".join(f" --set \"{setting}\"" for setting in args.settings)
+    written = "".join(f" --set {shlex.quote(setting)}" for setting in args.settings)
     lines = ["# The BHA split against the whole string", "",
              f"`python benchmarks/bha_split.py --scene {args.scene} --t-end {args.t_end:g} --lengths={args.lengths}"
              f"{written} --name {args.name}`. Machine: {platform.machine()}, {os.cpu_count()} cores ({processor()}), "
