@@ -141,3 +141,27 @@ def test_no_import_cycle():
         if module not in state:
             visit(module, [module])
     assert not cycles, cycles
+
+
+def test_a_scenes_string_and_well_are_resolved_once(monkeypatch):
+    """The mesh, the axial-torsional wall's normal forces, the soft string's study and the static state's start all
+    read the scene's string in its well from one object (:func:`~fenics_drill.model.well.string_in_well`): the well is
+    resolved from the scene's survey once per scene, and again for a changed scene."""
+    import fenics_drill as fd
+    from fenics_drill.model import well as wells
+    from fenics_drill.model.discretization import BeamDiscretization
+    from fenics_drill.model.forces.axial_torsional_wall import vertex_normal_forces
+    from fenics_drill.studies.torque_drag import torque_drag_study
+
+    calls = []
+    resolve = wells.well_of
+    monkeypatch.setattr(wells, "well_of", lambda *args: calls.append(args) or resolve(*args))
+    scene = fd.load_scene("demos/scenes/well_build_hold.toml", ["beam.elements=60", "model.lateral_length=0"])
+    disc = BeamDiscretization.from_scene(scene)
+    vertex_normal_forces(scene, disc.vertex_x)
+    torque_drag_study(scene)
+    assert wells.string_in_well(scene) is wells.string_in_well(scene)
+    assert len(calls) == 1
+    changed = scene.with_changes(beam={"elements": 70})
+    assert wells.string_in_well(changed).well is not wells.string_in_well(scene).well
+    assert len(calls) == 2

@@ -26,8 +26,8 @@ from mpi4py import MPI
 from fenics_drill.forms import FIELD_NAMES, BeamProperties
 from fenics_drill.forms.properties import CurvedAxis
 from fenics_drill.model.resources import check_memory
-from fenics_drill.model.string_sections import fe_sections, string_sections
-from fenics_drill.model.well import Trajectory, well_of
+from fenics_drill.model.string_sections import fe_sections
+from fenics_drill.model.well import Trajectory, string_in_well
 
 #: Index of each field in the mixed space, in the paper's order (the one place they are declared).
 U, V, W, THETA_X, THETA_Y, THETA_Z = range(6)
@@ -194,10 +194,10 @@ class BeamDiscretization:
         if not (sectioned or scene.well.survey or scene.well.md):
             return cls(scene.beam_properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports,
                        scene.supports.stabilisers, lateral_length=lateral, axial_torsional_element_length=coarse)
-        strings = string_sections(scene)
-        well = well_of(scene, strings[-1].bottom)
+        resolved = string_in_well(scene)
+        strings, well = resolved.sections, resolved.well
         properties = replace(scene.beam_properties, length=strings[-1].bottom)
-        layout = (lambda cells, vertices: fe_sections(scene, well.hole.radius, cells, vertices)) if sectioned else None
+        layout = (lambda cells, vertices: fe_sections(scene, strings, well.hole.radius, cells, vertices)) if sectioned else None
         trajectory = well.trajectory if (scene.well.survey or scene.well.md) else None
         # a vertex at every survey station keeps each element on one arc of constant curvature; a survey denser
         # than the mesh (a station every few cm) would make the mesh its own: its elements then take the

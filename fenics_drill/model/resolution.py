@@ -15,7 +15,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from fenics_drill.model.string_sections import string_sections
+from fenics_drill.model.well import string_in_well
 from fenics_drill.model.well import hanging_tension
 
 #: Fewest displacement nodes (elements x degree) per flexural wavelength at f_max for the band to be carried
@@ -57,7 +57,7 @@ def nodes_per_wavelength(scene) -> float:
     if not scene.string.sections:
         md = np.linspace(0.0, length, TENSION_SAMPLES * b.elements + 1)
         return float(np.min(flexural_wavelength(p, f_max, hanging_tension(scene, md, scene.modal_weight_on_bit)))) / spacing
-    sections = string_sections(scene)
+    sections = string_in_well(scene).sections
     lateral_top = length - scene.model.lateral_length if scene.model.lateral_length > 0 else 0.0
     shortest = np.inf
     for s in sections:

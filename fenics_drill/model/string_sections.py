@@ -118,13 +118,12 @@ class FESections:
         return self.hole_radius - self.contact_radius
 
 
-def fe_sections(scene, hole_radius_at, cell_x: np.ndarray, vertex_x: np.ndarray) -> FESections:
-    """The scene's string (:func:`string_sections`) on cells with midpoints ``cell_x`` and on vertices ``vertex_x``,
-    in a hole whose radius at measured depth s is ``hole_radius_at(s)``.  Tool joints are homogenised over their
+def fe_sections(scene, sections, hole_radius_at, cell_x: np.ndarray, vertex_x: np.ndarray) -> FESections:
+    """The scene's string (``sections``, :func:`string_sections`) on cells with midpoints ``cell_x`` and on vertices
+    ``vertex_x``, in a hole whose radius at measured depth s is ``hole_radius_at(s)``.  Tool joints are homogenised over their
     pitch: the density carries their steel, the stiffness and rotary-inertia factors their stiffness and polar
     inertia (module doc), and they give the contact radius; at a vertex between two sections the larger contact
     radius.  Raises SceneError where a section does not fit the hole."""
-    sections = string_sections(scene)
     g = scene.environment.gravity if scene.model.gravity else 0.0
     outer_fluid, inner_fluid = scene.fluid.density, scene.inner_fluid_density
     k = section_at(sections, cell_x)

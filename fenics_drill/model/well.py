@@ -14,6 +14,7 @@ import dataclasses
 import functools
 import math
 import re
+import weakref
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -464,6 +465,38 @@ def well_of(scene, string_length: float) -> Well:
     return Well(trajectory, HoleSections(bottoms, radii, cased))
 
 
+@dataclass(frozen=True)
+class StringInWell:
+    """A scene's string resolved once in its well: the sections from the surface down (the bit at the bottom of the
+    last) and the well they hang in (:func:`well_of`)."""
+
+    sections: tuple
+    well: Well
+
+    @property
+    def length(self) -> float:
+        """The string's length, the bit's measured depth [m]."""
+        return self.sections[-1].bottom
+
+
+#: The scenes resolved so far, by identity (a scene is immutable; each entry goes with its scene).
+_RESOLVED: dict[int, tuple[weakref.ref, StringInWell]] = {}
+
+
+def string_in_well(scene) -> StringInWell:
+    """The scene's :class:`StringInWell`, resolved at the first call for this scene and read from then on (raises
+    SceneError as :func:`well_of` does)."""
+    key = id(scene)
+    known = _RESOLVED.get(key)
+    if known is not None and known[0]() is scene:
+        return known[1]
+    sections = tuple(string_sections(scene))
+    resolved = StringInWell(sections, well_of(scene, sections[-1].bottom))
+    _RESOLVED[key] = (weakref.ref(scene), resolved)
+    weakref.finalize(scene, _RESOLVED.pop, key, None)
+    return resolved
+
+
 def hanging_tension(scene, md, weight_on_bit: float) -> np.ndarray:
     """The effective tension [N] at measured depths ``md`` of the scene's string hanging in its well with
     ``weight_on_bit`` on the bit: the buoyed weight below each point along the axis, less the weight on bit
@@ -472,9 +505,9 @@ def hanging_tension(scene, md, weight_on_bit: float) -> np.ndarray:
     md = np.asarray(md, dtype=float)
     if not (scene.well.survey or scene.well.md) or not scene.model.gravity:
         return np.full_like(md, -weight_on_bit)
-    sections = string_sections(scene)
-    trajectory = well_of(scene, sections[-1].bottom).trajectory
-    fine = np.linspace(0.0, sections[-1].bottom, max(2001, 4 * scene.beam.elements + 1))
+    resolved = string_in_well(scene)
+    sections, trajectory = resolved.sections, resolved.well.trajectory
+    fine = np.linspace(0.0, resolved.length, max(2001, 4 * scene.beam.elements + 1))
     weight = np.array([s.buoyed_weight(scene.environment.gravity, scene.fluid.density, scene.inner_fluid_density)
                        for s in sections])[section_at(sections, fine)]
     along = weight * np.cos(trajectory.inclination(fine))  # the weight's component down the axis [N/m]
@@ -507,7 +540,7 @@ def check_string_in_well(scene) -> Well | None:
     The well, or None for the paper's straight hole of one pipe."""
     if not (scene.well.survey or scene.well.md or scene.string.sections):
         return None
-    well = well_of(scene, string_sections(scene)[-1].bottom)
+    well = string_in_well(scene).well
     check_weight_on_bit(scene)
     return well
 
@@ -517,8 +550,8 @@ def bit_above_bottom(scene) -> float:
     they agree within DEPTH_ROUND_OFF and in the paper's straight hole (as long as its string)."""
     if not (scene.well.survey or scene.well.md):
         return 0.0
-    length = string_sections(scene)[-1].bottom
-    gap = well_of(scene, length).depth - length
+    resolved = string_in_well(scene)
+    gap = resolved.well.depth - resolved.length
     return gap if gap > DEPTH_ROUND_OFF else 0.0
 
 
@@ -531,6 +564,6 @@ def well_notes(scene) -> list[str]:
     notes = list(well.notes)
     above = bit_above_bottom(scene)
     if above > 0:
-        notes.insert(0, f"the bit is {above:.4g} m above the well's bottom (a {string_sections(scene)[-1].bottom:.6g} m "
+        notes.insert(0, f"the bit is {above:.4g} m above the well's bottom (a {string_in_well(scene).length:.6g} m "
                         f"string in a {well.depth:.6g} m well): 'on bottom' means the bit on the rock there")
     return notes

@@ -17,8 +17,7 @@ import numpy as np
 from fenics_drill.model.discretization import U, V, W
 from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.model.soft_string import Operation, soft_string, string_mesh
-from fenics_drill.model.string_sections import string_sections
-from fenics_drill.model.well import well_of
+from fenics_drill.model.well import string_in_well
 from fenics_drill.solvers.newton import saddle_newton
 
 #: Contact stiffness continuation: the wall springs are scaled by 10^s, s rising from FIRST_STAGE to 0 in steps
@@ -132,10 +131,10 @@ def resting_guess(model: DrillstringModel) -> np.ndarray | None:
     disc, scene = model.disc, model.scene
     if disc.trajectory is None or not model.space.sparse:
         return None
-    sections = string_sections(scene)
+    resolved = string_in_well(scene)
+    sections, well = resolved.sections, resolved.well
     g = scene.environment.gravity if scene.model.gravity else 0.0
     weights = [s.buoyed_weight(g, scene.fluid.density, scene.inner_fluid_density) for s in sections]
-    well = well_of(scene, sections[-1].bottom)
     mesh = string_mesh(well, sections, float(np.diff(disc.vertex_x).min()), weights, 0.0, 0.0)
     pressed = model.force("axial_tip_load")  # a string on bottom: the bit pressed with the weight on bit
     rest = soft_string(mesh, Operation("at rest", 0.0, 0.0, -pressed.force if pressed is not None else 0.0, 0.0))

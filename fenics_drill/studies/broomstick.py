@@ -31,8 +31,8 @@ import numpy as np
 from fenics_drill.forms import section_constants
 from fenics_drill.io.files import write_atomic, write_json
 from fenics_drill.model.soft_string import Operation, operations, soft_string_batch, string_mesh
-from fenics_drill.model.string_sections import string_at_bit_depth, string_sections
-from fenics_drill.model.well import well_of
+from fenics_drill.model.string_sections import string_at_bit_depth
+from fenics_drill.model.well import string_in_well
 from fenics_drill.observables.buckling import helical_load
 from fenics_drill.scene import SceneError
 from fenics_drill.studies.lifecycle import command_output
@@ -140,8 +140,9 @@ class ChartString:
             raise SceneError("a broomstick chart needs a well: give its survey in [well] (survey or md, inclination, "
                              "azimuth) and its string in [[string.sections]]")
         self.scene = scene
-        self.sections = string_sections(scene)
-        self.well = well if well is not None else well_of(scene, self.sections[-1].bottom)
+        resolved = string_in_well(scene)
+        self.sections = list(resolved.sections)
+        self.well = well if well is not None else resolved.well
         self._made_up = {}
 
     def made_up(self, depth: float):

@@ -19,8 +19,7 @@ import numpy as np
 from fenics_drill.io.files import write_atomic, write_json
 from fenics_drill.model.discretization import THETA_X, THETA_Y, THETA_Z, U, V, W
 from fenics_drill.model.soft_string import operations, soft_string, stretch, string_mesh
-from fenics_drill.model.string_sections import string_sections
-from fenics_drill.model.well import dogleg_severity_deg_per_30m, well_of
+from fenics_drill.model.well import dogleg_severity_deg_per_30m, string_in_well
 from fenics_drill.observables.buckling import buckled_spans, helical_load, sinusoidal_load
 from fenics_drill.observables.torque_drag import string_profiles
 from fenics_drill.scene import SceneError
@@ -40,8 +39,8 @@ def torque_drag_study(scene) -> dict:
     """The soft-string study of a scene: ``report`` (JSON-ready) and ``profiles`` (an ``xarray.Dataset``: node values
     over ``md``, element values over ``md_element``)."""
     clock = time.perf_counter()
-    sections = string_sections(scene)
-    well = well_of(scene, sections[-1].bottom)
+    resolved = string_in_well(scene)
+    sections, well = resolved.sections, resolved.well
     g = scene.environment.gravity
     outer, inner = _fluids(scene)
     weights = np.array([s.buoyed_weight(g, outer, inner) for s in sections])
@@ -157,7 +156,7 @@ def fe_static_profiles(scene, model, q):
     p = disc.element_properties
     stiffness, weight = p.young_modulus * p.section.I4, p.density * p.section.area * p.gravity
     clearance = np.minimum(model.vertex_gap[1:], model.vertex_gap[:-1])
-    trajectory = disc.trajectory if disc.trajectory is not None else well_of(scene, disc.properties.length).trajectory
+    trajectory = disc.trajectory if disc.trajectory is not None else string_in_well(scene).well.trajectory
     inclination, curvature = trajectory.inclination(middle), trajectory.curvature(middle)
     operation = "rotating_on_bottom" if scene.starts_on_bottom else "rotating_off_bottom"  # what the state carries
     soft = torque_drag_study(scene.with_changes(torque_drag={"operations": [operation]}))["profiles"]

@@ -26,8 +26,7 @@ from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
 from fenics_drill.model.forces.wall.coulomb import coulomb_friction
 from fenics_drill.model.soft_string import operations, soft_string, string_mesh
-from fenics_drill.model.string_sections import string_sections
-from fenics_drill.model.well import well_of
+from fenics_drill.model.well import string_in_well
 
 
 @dataclass
@@ -42,10 +41,10 @@ class AxialTorsionalWallForces(ForceEvaluation):
 def vertex_normal_forces(scene, x: np.ndarray) -> np.ndarray:
     """N_i [N] at vertices ``x`` (measured depths along the string): the soft string's wall force per length of the
     scene's operation (module doc), integrated over the half elements beside each vertex."""
-    sections = string_sections(scene)
+    resolved = string_in_well(scene)  # the paper's straight horizontal hole without a survey
+    sections, well = resolved.sections, resolved.well
     g = scene.environment.gravity if scene.model.gravity else 0.0
     weights = np.array([s.buoyed_weight(g, scene.fluid.density, scene.inner_fluid_density) for s in sections])
-    well = well_of(scene, sections[-1].bottom)  # the paper's straight horizontal hole without a survey
     mu = scene.contact.friction
     mesh = string_mesh(well, sections, min(scene.torque_drag.element_length, float(np.diff(x).min())),
                        weights, mu, mu)
