@@ -8,7 +8,9 @@ It knows nothing about files: every accepted step is handed to ``on_step`` as a
 
 from __future__ import annotations
 
+import collections
 import contextlib
+import math
 
 import time
 from dataclasses import dataclass
@@ -24,7 +26,10 @@ from fenics_drill.solvers.step_control import RunFailure, StepController
 
 
 #: A string whose top moves axially faster than this many times the set rate V0 (and than RUNAWAY_FLOOR) under a
-#: hook-load drive falls or is pulled out: the hook load does not hold it, and the run ends "failed".
+#: hook-load drive, on average over the axial wave's round trip 2 L / c along the string, falls or is pulled out:
+#: the hook load does not hold it, and the run ends "failed".  The mean, not the top's speed at one instant: the
+#: axial wave that a bit leaving the rock sends up a long string swings the top by F / (rho c A) (60 kN on 5 in drill
+#: pipe: 0.44 m/s) and back within that round trip, while the string stays held.
 RUNAWAY_FACTOR = 100.0
 RUNAWAY_FLOOR = 0.5  # [m/s], 1800 m/h: faster than any drilling
 
@@ -67,6 +72,9 @@ class Simulation:
                       "sampling_checks": 0, "max_sampling_error": 0.0, "sample_retrainings": 0}
         self._next_sampling_check = 0.0
         self.last_state: State | None = None  # the latest accepted state (what an interrupted run keeps)
+        p = scene.beam_properties
+        self._round_trip = 2.0 * model.disc.properties.length / math.sqrt(p.young_modulus / p.density)
+        self._top_travel = collections.deque()  # (t, the top's axial travel since the start) over the last round trip
 
     def initial_state(self, q0: np.ndarray, qd0: np.ndarray | None = None) -> State:
         """Displacement q0 (the static equilibrium), velocity (V0, Omega) of Section 3.2 (or ``qd0``), and the
@@ -117,17 +125,30 @@ class Simulation:
 
     def _check_top(self, state: State) -> None:
         """Raise Runaway where the drive leaves the top free axially (a hook load) and it moves faster than
-        RUNAWAY_FACTOR times the set rate V0 (at least RUNAWAY_FLOOR)."""
+        RUNAWAY_FACTOR times the set rate V0 (at least RUNAWAY_FLOOR) on average over the last axial round trip (over
+        the run so far, before one has passed)."""
         drive = self.model.drive
         if drive.held[0]:
             return
         speed = drive.velocities(state.qd)[0]
+        travel = self._top_travel
+        if travel:
+            t0, s0, v0 = travel[-1]
+            travel.append((state.t, s0 + 0.5 * (v0 + speed) * (state.t - t0), speed))
+        else:
+            travel.append((state.t, 0.0, speed))
+        while len(travel) > 2 and travel[1][0] <= state.t - self._round_trip:
+            travel.popleft()
+        (t_first, s_first, v_first), (t_now, s_now, _) = travel[0], travel[-1]
+        mean = (s_now - s_first) / (t_now - t_first) if t_now > t_first else v_first
         limit = max(RUNAWAY_FACTOR * abs(drive.rate[0]), RUNAWAY_FLOOR)
-        if abs(speed) > limit:
-            way = "falls" if speed > 0 else "is pulled out of the hole"
-            raise Runaway(f"at t = {state.t:.4g} s the top moves at {speed:.3g} m/s ({speed * 3600:.4g} m/h), more "
-                          f"than {limit:.3g} m/s: the string {way}; the hook load {-drive.top_force / 1e3:.4g} kN "
-                          "does not hold it (check drive.weight_on_bit and the bit's law)")
+        if abs(mean) > limit:
+            way = "falls" if mean > 0 else "is pulled out of the hole"
+            raise Runaway(f"at t = {state.t:.4g} s the top has moved at {mean:.3g} m/s ({mean * 3600:.4g} m/h) on "
+                          f"average over the last {t_now - t_first:.3g} s (the axial round trip is "
+                          f"{self._round_trip:.3g} s), more than {limit:.3g} m/s: the string {way}; the hook load "
+                          f"{-drive.top_force / 1e3:.4g} kN does not hold it (check drive.weight_on_bit and the bit's "
+                          "law)")
 
     def run(self, state: State, t_end: float, on_step=None, progress=None, atomic=contextlib.nullcontext) -> State:
         """Step from ``state`` to t_end; raises StepTooSmall (with when and why) if the step collapses, Runaway if a
