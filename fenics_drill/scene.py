@@ -218,8 +218,7 @@ class Model:
     lateral_length: float = key(-1.0, "length above the bit whose lateral fields are solved; -1: all, 0: none [m]",
                                 lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for the whole string)")
     axial_torsional_element_length: float = key(
-        -1.0, "element length above the lateral length, where only u and theta_x are solved; -1: as below it "
-        "(beam.elements over the string) [m]", lambda x: x == -1.0 or x > 0, "> 0 (or -1 for the lateral part's)")
+        -1.0, "element length above the lateral length (u and theta_x only); -1: as below it [m]", lambda x: x == -1.0 or x > 0, "> 0 (or -1 for the lateral part's)")
 
 
 def _positions(x) -> bool:
