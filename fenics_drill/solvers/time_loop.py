@@ -74,7 +74,7 @@ class Simulation:
         self.last_state: State | None = None  # the latest accepted state (what an interrupted run keeps)
         p = scene.beam_properties
         self._round_trip = 2.0 * model.disc.properties.length / math.sqrt(p.young_modulus / p.density)
-        self._top_travel = collections.deque()  # (t, the top's axial travel since the start) over the last round trip
+        self._top_travel = collections.deque()  # (t, the top's travel since the start, its speed) over a round trip
 
     def initial_state(self, q0: np.ndarray, qd0: np.ndarray | None = None) -> State:
         """Displacement q0 (the static equilibrium), velocity (V0, Omega) of Section 3.2 (or ``qd0``), and the

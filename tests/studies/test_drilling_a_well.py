@@ -163,6 +163,8 @@ def test_an_axial_wave_swinging_the_top_is_not_a_runaway(well):
     model = simulation.model
     model.drive.velocities = lambda qd: (float(qd[0]), 0.0)
     trip = simulation._round_trip
+    # the window is the string's (900 m, not a section's or the mesh's) round trip at steel's bar speed; the same
+    # arithmetic on both sides, so equal to round-off
     assert trip == pytest.approx(2 * 900.0 / np.sqrt(scene.beam.young_modulus / scene.beam.density), rel=1e-12)
     empty = np.zeros(0)
 
