@@ -133,25 +133,28 @@ drill-vbh: setup
 ## friction each realisation of 10 s runs the full order: 8 took 327 s on 2 ranks here, docs/performance.md).
 SAMPLES ?= 32
 RANKS ?= 2
+## A study's directory is continued (--resume) when an earlier run of it left its summary there, and started
+## afresh otherwise (the command refuses --resume of a directory that holds no study).
+resume = $(if $(wildcard $(1)/summary.json),--resume,)
 mc: setup
-	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli mc demos/scenes/paper.toml --samples $(SAMPLES) --out $(OUT)/mc --resume
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli mc demos/scenes/paper.toml --samples $(SAMPLES) --out $(OUT)/mc $(call resume,$(OUT)/mc)
 	$(PY) -m fenics_drill.cli plot $(OUT)/mc
 
 ## The paper's operating windows (Sections 6.9, 6.10, 6.12) at the resolution of demos/scenes/window*.toml.
 optimize: setup
-	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/window_rop.toml --out $(OUT)/window-rop --resume
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/window_rop.toml --out $(OUT)/window-rop $(call resume,$(OUT)/window-rop)
 	$(PY) -m fenics_drill.cli plot $(OUT)/window-rop
-	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/window_efficiency.toml --out $(OUT)/window-efficiency --resume
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/window_efficiency.toml --out $(OUT)/window-efficiency $(call resume,$(OUT)/window-efficiency)
 	$(PY) -m fenics_drill.cli plot $(OUT)/window-efficiency
-	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/window_robust.toml --out $(OUT)/window-robust --resume
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/window_robust.toml --out $(OUT)/window-robust $(call resume,$(OUT)/window-robust)
 	$(PY) -m fenics_drill.cli plot $(OUT)/window-robust
 
 ## Stick-slip maps of the paper's string with the cutting law, stiff drive and soft-torque top drive
 ## (docs/guide/drilling_control.md), and the linear stability of steady drilling.
 stick-slip: setup
-	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/stick_slip_map.toml --out $(OUT)/stick-slip-stiff --resume
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/stick_slip_map.toml --out $(OUT)/stick-slip-stiff $(call resume,$(OUT)/stick-slip-stiff)
 	$(PY) -m fenics_drill.cli plot $(OUT)/stick-slip-stiff
-	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/stick_slip_map_soft_torque.toml --out $(OUT)/stick-slip-soft --resume
+	.venv/bin/mpiexec -n $(RANKS) $(PY) -m fenics_drill.cli optimize demos/scenes/stick_slip_map_soft_torque.toml --out $(OUT)/stick-slip-soft $(call resume,$(OUT)/stick-slip-soft)
 	$(PY) -m fenics_drill.cli plot $(OUT)/stick-slip-soft
 	$(PY) benchmarks/stick_slip_table.py $(OUT)/stick-slip-stiff $(OUT)/stick-slip-soft
 	$(PY) benchmarks/stick_slip_stability.py

@@ -56,3 +56,24 @@ def test_the_demo_wells_static_and_run_end_finished(tmp_path):
                 failures.append(f"{command} {scene}: {summary.get('status')} "
                                 f"{summary.get('suspect_reasons') or summary.get('message') or done.stderr[-300:]}")
     assert not failures, "\n".join(failures)
+
+
+STUDY_TARGETS = {"mc": "mc", "optimize": "window-rop", "stick-slip": "stick-slip-stiff"}
+
+
+def test_the_study_targets_start_a_fresh_directory_and_continue_an_interrupted_one(tmp_path):
+    """`make mc`, `make optimize` and `make stick-slip` pass --resume only to a study directory an earlier run left
+    its summary in: the commands refuse --resume of a directory that holds no study, so a first run on a fresh
+    machine would otherwise end at its first line (`make -n` prints the commands without running them)."""
+    for target, directory in STUDY_TARGETS.items():
+        def commands():
+            done = subprocess.run(["make", "-n", target, f"OUT={tmp_path}"], cwd=ROOT, capture_output=True,
+                                  text=True, timeout=60)
+            assert done.returncode == 0, done.stderr
+            return [line for line in done.stdout.splitlines() if f"--out {tmp_path}/{directory} " in line + " "]
+
+        fresh = commands()
+        assert fresh and not any("--resume" in line for line in fresh), (target, fresh)
+        (tmp_path / directory).mkdir()
+        (tmp_path / directory / "summary.json").write_text("{}")
+        assert all("--resume" in line for line in commands()), target
