@@ -67,6 +67,11 @@ def _run(label: str, command: list[str], done: Path) -> float:
     return time.perf_counter() - start
 
 
+def _resume(out: Path) -> list[str]:
+    """--resume for a study an earlier run left its summary in (the commands refuse it for a directory without)."""
+    return ["--resume"] if (out / "summary.json").exists() else []
+
+
 def _window_overrides(window: str, t_end: float) -> list[str]:
     """The [optimize] keys of demos/scenes/window_<window>.toml as --set overrides, over t_end."""
     scene = tomllib.loads(Path(f"demos/scenes/window_{window}.toml").read_text())
@@ -89,13 +94,13 @@ def studies(args) -> dict:
         for window in WINDOWS:
             out = args.runs / f"window-{window}-{model}"
             costs[out.name] = _run(f"{window} window {model}", _command(
-                "optimize", scene, *MODEL_SETS[model], *_window_overrides(window, args.t_end), "--quiet", "--resume",
+                "optimize", scene, *MODEL_SETS[model], *_window_overrides(window, args.t_end), "--quiet", *_resume(out),
                 "--out", str(out), ranks=args.ranks), out / "optimize.json")
             subprocess.run(_command("plot", str(out)), check=False)
         out = args.runs / f"mc-{model}"
         costs[out.name] = _run(f"Monte Carlo {model}", _command(
             "mc", scene, *MODEL_SETS[model], "--samples", str(args.samples), "--set", f"time.t_end={args.t_end}",
-            "--quiet", "--resume",
+            "--quiet", *_resume(out),
             "--out", str(out), ranks=args.ranks), out / "statistics.h5")
         subprocess.run(_command("plot", str(out)), check=False)
     return costs
