@@ -115,6 +115,14 @@ def differences(row: dict, reference: dict | None) -> str:
     return ", ".join(parts)
 
 
+def cost_cells(row: dict, reference: dict | None, unit: float, digits: int = 1) -> str:
+    """A run's table cells: Newton iterations (per step), integration per simulated second [s] and in machine units,
+    and its differences from ``reference``."""
+    per_second = row["integration_time_s"] / row["t_end"]
+    return (f"{row['newton_iterations']} ({row['newton_iterations'] / max(row['steps'], 1):.1f}) | "
+            f"{per_second:.{digits}f} | {per_second / unit:.0f} | {differences(row, reference)}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rows", nargs="+", default=list(ROWS), choices=list(ROWS))
