@@ -30,10 +30,17 @@ SIGNALS = (signal.SIGINT, signal.SIGTERM)
 class StopOnSignal:
     """Context manager: the first SIGINT/SIGTERM raises KeyboardInterrupt (at the end of an
     :func:`uninterrupted` block if it arrives inside one), later ones are ignored; the previous handlers
-    come back on exit (a no-op outside the main thread, where Python has no handlers)."""
+    come back on exit (a no-op outside the main thread, where Python has no handlers).
+
+    ``collective`` (the ranks of one shared run): the signal is only noted, and the ranks stop together where they
+    exchange it (:func:`agree_to_stop`, :func:`uninterrupted` with ``comm``).  A rank that raised at once, between
+    two exchanges, would stop a step before the others and leave them waiting in a collective it never joins."""
 
     #: The innermost StopOnSignal of this process, which :func:`uninterrupted` defers.
     active: "StopOnSignal | None" = None
+
+    def __init__(self, collective: bool = False) -> None:
+        self.collective = collective
 
     def __enter__(self) -> "StopOnSignal":
         self.previous = None
@@ -58,7 +65,7 @@ class StopOnSignal:
         for s in SIGNALS:
             signal.signal(s, signal.SIG_IGN)
         self.requested = True
-        if not self.deferring:
+        if not self.deferring and not self.collective:
             raise KeyboardInterrupt
 
     def __exit__(self, *exc) -> None:
@@ -72,7 +79,22 @@ class StopOnSignal:
 def stop_if_requested() -> None:
     """Raise KeyboardInterrupt if a signal arrived and its interrupt was lost (a study checks between tasks)."""
     stop = StopOnSignal.active
-    if stop is not None and stop.requested and not stop.deferring:
+    if stop is not None and stop.requested and not stop.deferring and not stop.collective:
+        raise KeyboardInterrupt
+
+
+def _asked_on_any_rank(comm) -> bool:
+    """Whether a signal arrived on any rank of ``comm`` (a collective call)."""
+    from mpi4py import MPI
+
+    stop = StopOnSignal.active
+    return comm.allreduce(stop is not None and stop.requested, op=MPI.LOR)
+
+
+def agree_to_stop(comm) -> None:
+    """Raise KeyboardInterrupt on every rank of ``comm`` if a signal arrived on any of them (a collective call:
+    every rank makes it at the same point of a shared run)."""
+    if _asked_on_any_rank(comm):
         raise KeyboardInterrupt
 
 
@@ -85,7 +107,8 @@ def uninterrupted(stop_after: bool = True, comm=None):
     (the writing of a summary), the signal is ignored.  ``comm``: the ranks that take the steps of one run together
     (:mod:`~fenics_drill.studies.shared_run`) tell each other at the end of the block whether a signal arrived, and
     if one did on any of them, every rank raises KeyboardInterrupt after the same step (a rank that stopped alone
-    would leave the others waiting in the step's collectives)."""
+    would leave the others waiting in the step's collectives); under a ``collective`` :class:`StopOnSignal` a block
+    without ``comm`` does not stop the rank."""
     stop = StopOnSignal.active
     if stop is None:
         yield
@@ -93,17 +116,15 @@ def uninterrupted(stop_after: bool = True, comm=None):
     stop.deferring += 1
     try:
         yield
-        agreed = stop.requested
+        agreed = stop.requested and not stop.collective
         if stop_after and comm is not None:
-            from mpi4py import MPI
-
             # told while the signal is still deferred: a rank waiting here for a slower one, where a signal most
             # often lands, must not leave the exchange alone (the other would stop a step later, in a collective
             # this rank never joins); a signal after its share was sent waits for the next step's exchange
-            agreed = comm.allreduce(stop.requested, op=MPI.LOR)
+            agreed = _asked_on_any_rank(comm)
     finally:
         stop.deferring -= 1
-    if stop_after and (agreed or (comm is None and stop.requested)) and not stop.deferring:
+    if stop_after and agreed and not stop.deferring:
         raise KeyboardInterrupt
 
 

@@ -39,7 +39,8 @@ from fenics_drill.model.resolution import band_frequency, mesh_advice
 from fenics_drill.solvers.step_control import (RunFailure, check_run_length, least_steps, nominal_step,
                                               steps_per_band_period)
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
-from fenics_drill.studies.lifecycle import StopOnSignal, command_output, scene_record, uninterrupted
+from fenics_drill.studies.lifecycle import (StopOnSignal, agree_to_stop, command_output, scene_record, stop_if_requested,
+                                            uninterrupted)
 from fenics_drill.studies.operating_state import REPORTED_MODES, state_of, unstable_modes
 from fenics_drill.studies.prepare import prepare
 from fenics_drill.studies.shared_run import check_ranks, check_same_state, second_rank_run, shared_model
@@ -319,13 +320,15 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
                                           "t_end": t, "steps": max(rows - 1, 0), "rows": rows,
                                           "wall_time_s": time.perf_counter() - clock})
 
-    with StopOnSignal():
+    with StopOnSignal(collective=comm.size > 1) as stop:
         try:
             setup = SetupProgress(progress)
             try:
                 prepared = prepare(scene, stage=setup)
             finally:
                 setup.close()
+            if comm.size > 1:
+                agree_to_stop(comm)
             model, equilibrium = prepared.model, prepared.equilibrium
             summary["reduced_size"], summary["full_dofs"] = model.size, model.disc.ndofs
             summary["basis_guard"] = model.guard
@@ -336,6 +339,9 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
                 model, summary["ranks"] = shared_model(model, comm)
                 if summary["ranks"]["split"]:
                     atomic = functools.partial(uninterrupted, comm=comm)
+                else:  # the second rank has left: this one runs alone, and a signal stops it at once
+                    stop.collective = False
+                    stop_if_requested()
             simulation = Simulation(model, scene)
             start = simulation.initial_state(equilibrium.q)
             if atomic is not uninterrupted:

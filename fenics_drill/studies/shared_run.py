@@ -7,8 +7,8 @@ update is solved across both (:mod:`~fenics_drill.model.kernels.split_band`).  E
 and takes the same steps; the first writes the files and the summary, the other writes nothing.  A reduced
 (modal) model, which runs near real time on one core, is not split: the first rank runs it alone.
 
-A signal on any rank stops both after the same step (:func:`~fenics_drill.studies.lifecycle.
-uninterrupted` with ``comm``); an error on one rank alone ends the job (the command line's MPI_Abort).
+A signal on any rank stops both after the same step (a ``collective`` :class:`~fenics_drill.studies.lifecycle.
+StopOnSignal`: the ranks exchange it after the set-up and after every step); an error on one rank alone ends the job (the command line's MPI_Abort).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from fenics_drill.model.internal_force import AssembledInternalForce
 from fenics_drill.solvers.static import StaticFailure
 from fenics_drill.solvers.step_control import RunFailure
 from fenics_drill.solvers.time_loop import Simulation
-from fenics_drill.studies.lifecycle import StopOnSignal, uninterrupted
+from fenics_drill.studies.lifecycle import StopOnSignal, agree_to_stop, uninterrupted
 from fenics_drill.studies.prepare import prepare
 
 
@@ -70,9 +70,10 @@ def second_rank_run(scene, comm, refused: str | None) -> dict:
     if refused is not None:
         return {"status": "failed", "message": refused}
     summary = {"status": "failed", "message": ""}
-    with StopOnSignal():
+    with StopOnSignal(collective=True):
         try:
             prepared = prepare(scene)
+            agree_to_stop(comm)
             model, report = shared_model(prepared.model, comm)
             if not report["split"]:
                 return {"status": "finished", "message": f"the first rank ran it alone: {report['why']}"}

@@ -335,6 +335,30 @@ def test_an_interrupt_that_something_swallowed_still_stops_the_run_at_the_next_s
                 pass
 
 
+def test_the_ranks_of_a_shared_run_stop_only_where_they_exchange_the_signal():
+    """The CI saw a two-rank run crash in MPI ("Message truncated") after Ctrl-C: one rank got the signal between
+    two steps, raised at once and left, while the other, which had not yet seen it, went on to the next step's
+    exchange and met the first rank's exit in it.  Under a collective StopOnSignal a signal outside any block,
+    and inside a block without ``comm``, must not raise; the next exchange with ``comm`` stops every rank."""
+    from fenics_drill.studies.lifecycle import StopOnSignal, agree_to_stop, uninterrupted
+
+    class OneRank:  # what an allreduce with MPI.LOR gives on one rank
+        def allreduce(self, value, op):
+            return value
+
+    with StopOnSignal(collective=True):
+        agree_to_stop(OneRank())  # no signal yet: nothing
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.05)  # between two steps: only noted
+        with uninterrupted():  # a block that is not an exchange (the set-up's own runs)
+            pass
+        with pytest.raises(KeyboardInterrupt):
+            with uninterrupted(comm=OneRank()):
+                pass
+        with pytest.raises(KeyboardInterrupt):
+            agree_to_stop(OneRank())
+
+
 # 7. Impossible states are not "finished"
 
 
