@@ -10,6 +10,10 @@ Rows (each `fenics-drill run` in its own process, default model and friction, no
 - ``3km``, ``6km``: the paper's cross-section at 3000 and 6000 m, 2 elements per metre, 1 s;
 - ``vbh``: `demos/scenes/well_vbh.toml` on 2000 elements, 1 s.
 
+Beside each run's cost: its Newton iterations (those of the accepted and rejected steps), the Newton solves that
+failed and cut the step (their iterations are not counted there), and the saddle matrices (76) factorised per
+simulated second (the failed solves' included; each about one machine unit on the 3 km band).
+
 The machine unit is one LAPACK banded LU and solve (dgbtrf + dgbtrs) of a 54 000-unknown band with kl = ku = 14,
 the full order's band at 3 km, timed in this process before and after the runs (median of 7): a row's cost in units
 can be compared across machines.  The reference of a row (``--reference-rows``) is the same run at a tenth of
@@ -154,9 +158,10 @@ def main() -> None:
         f"{args.workers} run(s) at a time, one core each.", "",
         f"Machine unit: one LAPACK dgbtrf + dgbtrs of {UNIT_SIZE} unknowns, kl = ku = {UNIT_BANDWIDTH}: "
         f"{unit_before * 1e3:.1f} ms before the runs, {unit_after * 1e3:.1f} ms after; the mean is the unit.", "",
-        "| run | space (integrator) | unknowns | steps | Newton iterations (per step) | set-up [s] | whole run [s] "
-        "| integration per simulated s [s] | [units] | peak memory [GB] | against the step-converged run |",
-        "|---|---|---|---|---|---|---|---|---|---|---|"]
+        "| run | space (integrator) | unknowns | steps | Newton iterations (per step) | failed Newton solves "
+        "| factorisations per simulated s | set-up [s] | whole run [s] | integration per simulated s [s] | [units] "
+        "| peak memory [GB] | against the step-converged run |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for name in args.rows:
         row = results[(name, None)]
         reference = results.get((name, DEFAULT_TOLERANCE / 10))
@@ -165,7 +170,7 @@ def main() -> None:
         lines.append(
             f"| {name} ({row['t_end']:g} s) | {space} (Newmark, Newton) | {row['reduced_size']} | {row['steps']} | "
             f"{row['newton_iterations']} ({row['newton_iterations'] / max(row['steps'], 1):.1f}) | "
-            f"{row['setup_time_s']:.1f} | {row['whole_run_s']:.1f} | {per_second:.1f} | {per_second / unit:.0f} | "
+            f"{row['newton_failures']} | {row['factorisations'] / row['t_end']:.0f} | {row['setup_time_s']:.1f} | {row['whole_run_s']:.1f} | {per_second:.1f} | {per_second / unit:.0f} | "
             f"{row['peak_memory_gb']:.2f} | {differences(row, reference)} |")
     if "3km" in args.rows and "6km" in args.rows:
         ratio = (results[("6km", None)]["integration_time_s"] / results[("3km", None)]["integration_time_s"])

@@ -61,6 +61,7 @@ class Simulation:
         model = model.fresh()  # its own cut surface and controller memory
         self.keeps_budget = energy_budget
         self.model, self.scene = model, scene
+        self._factorisations_at_start = model.space.factorisations
         solver = scene.solver
         self.stepper = NewmarkNewton(model, scene.time.newmark_alpha, solver.newton_tolerance,
                                      solver.newton_max_iterations, solver.tangent_reuse, scene.time.error_tolerance,
@@ -104,6 +105,11 @@ class Simulation:
         """Deepest indentation of the string into the wall at an evaluated state [m] (0 without contact)."""
         wall = ev.forces.get("wall")
         return float(wall.delta.max(initial=0.0)) if wall is not None else 0.0
+
+    @property
+    def factorisations(self) -> int:
+        """The saddle matrices (76) factorised since :meth:`run` started (failed Newton solves included)."""
+        return self.model.space.factorisations - self._factorisations_at_start
 
     @property
     def impacts_per_vertex(self) -> np.ndarray:
@@ -159,6 +165,7 @@ class Simulation:
         command passes :func:`fenics_drill.studies.lifecycle.uninterrupted`, so that Ctrl-C or SIGTERM stops the
         run between two steps, never with a step half booked."""
         model = self.model
+        self._factorisations_at_start = model.space.factorisations
         with atomic():  # the initial state, booked whole
             ev = model.evaluate(state.q, state.qd, state.qdd, state.mu)
             h0 = model.constraints @ state.q - model.drive_rate * state.t

@@ -555,6 +555,7 @@ def _dynamics_summary(model, simulation: Simulation, recorder: RunRecorder, stat
         "rejected_steps": stats["rejected_steps"],
         "newton_failures": stats["newton_failures"],
         "newton_iterations": stats["newton_iterations"],
+        "factorisations": simulation.factorisations,
         "compiled_steps": simulation.stepper.compiled_steps,
         "min_dt": stats["min_dt"], "max_dt": stats["max_dt"],
         "mean_bit_velocity": (u - u0) / t if t > 0 else 0.0,

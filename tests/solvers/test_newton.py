@@ -128,3 +128,34 @@ def test_a_kept_tangent_starts_newton_and_one_that_contracts_too_slowly_is_repla
         assert bool(fresh) == replaced
         # what the solve leaves for the next one: the tangent it used last
         assert kept.matrix[0, 0] == (1.0 + 3.0 * fresh[-1] ** 2 if replaced else slope)
+
+
+def test_a_runs_summary_counts_every_banded_factorisation_of_its_steps(tmp_path, monkeypatch):
+    """The summary's ``factorisations`` (the speed table's factorisations per simulated second) is the number of
+    LAPACK banded LUs of the saddle matrix (76) the time loop made: each call counted where LAPACK is called."""
+    import scipy.linalg.lapack as lapack
+
+    import fenics_drill.model.kernels.banded_saddle as banded_saddle
+    from fenics_drill.scene import load_scene
+    from fenics_drill.solvers.time_loop import Simulation
+    from fenics_drill.studies.run import run_scene
+
+    calls, real_lu, real_run = [], lapack.dgbtrf, Simulation.run
+
+    def counted_lu(*args, **kwargs):
+        calls.append(1)
+        return real_lu(*args, **kwargs)
+
+    def counted_run(self, *args, **kwargs):
+        calls.clear()  # the static state's factorisations are not the loop's
+        return real_run(self, *args, **kwargs)
+
+    monkeypatch.setattr(banded_saddle.lapack, "dgbtrf", counted_lu)
+    monkeypatch.setattr(Simulation, "run", counted_run)
+    scene = load_scene(None, ["reduction.rule=none", "beam.elements=60", "time.t_end=0.02",
+                              "output.field_interval=0"])
+    summary = run_scene(scene, tmp_path / "run", progress=False)
+    assert summary["steps"] > 0
+    assert summary["factorisations"] == len(calls) > 0
+    # a kept tangent is solved again without a new LU: fewer factorisations than Newton iterations
+    assert summary["factorisations"] < summary["newton_iterations"]

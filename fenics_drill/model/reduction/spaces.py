@@ -38,10 +38,12 @@ class SaddleFactorisation:
     def __init__(self, factorise):
         self.factorise = factorise  # (tangent, constraints) -> solve(rhs_q, rhs_c) -> (dq, mu)
         self.key = self.value = None
+        self.count = 0  # factorisations made
 
     def __call__(self, tangent, constraints):
         if self.key is None or self.key[0] is not tangent or self.key[1] is not constraints:
             self.key, self.value = (tangent, constraints), self.factorise(tangent, constraints)
+            self.count += 1
         return self.value
 
 
@@ -170,6 +172,11 @@ class ModalSpace:
     def size(self) -> int:
         return self.phi.shape[1]
 
+    @property
+    def factorisations(self) -> int:
+        """The saddle matrices (76) factorised in this space so far."""
+        return self._saddle.count
+
     def expand(self, q: np.ndarray) -> np.ndarray:
         return self.phi @ q
 
@@ -295,6 +302,11 @@ class FullSpace:
         banded_saddle.SparseSum`): no sparse sums, whose bookkeeping costs more than the banded LU, and a kept
         term's band is laid out once."""
         return SparseSum(terms, (self.size, self.size))
+
+    @property
+    def factorisations(self) -> int:
+        """The saddle matrices (76) factorised in this space so far (this rank's part of them, split)."""
+        return self._saddle.count
 
     def _factorise(self, tangent, constraints) -> BandedSaddle:
         return BandedSaddle(tangent, constraints, self.band_order, self.band_width)
