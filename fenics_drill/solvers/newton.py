@@ -5,7 +5,12 @@ solution space and takes the largest step of a backtracking line search on the
 residual norm (Armijo's sufficient decrease).  The wall law (17) has a kink at first
 contact and the bit-rock law (20) one at u_dot_bit = 0; a full Newton update can jump
 from one branch to the other and back forever, and halving the update until the
-residual norm decreases stops that.  What counts as converged is the caller's.
+residual norm decreases stops that.  Once a full update of a solve fails that test, the
+solve's line searches measure a trial by its Newton correction J^-1 r with the iterate's
+factorisation against the update's instead (natural monotonicity, Deuflhard 2004,
+Sec. 3.3): the residual's 2-norm weighs the stiff wall springs of resting vertices that
+switch between stuck and sliding along the update, and halving on it crawled (measured:
+docs/performance.md, "Newton's iterations").  What counts as converged is the caller's.
 """
 
 from __future__ import annotations
@@ -66,7 +71,8 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
     (a straight string falling onto the wall) the residual need not decrease along it.  With
     ``reuse_rate`` > 0 the tangent of an earlier iterate is kept while each full update shrinks the
     residual norm at least by that factor (a modified Newton with a convergence-rate test; Deuflhard
-    2004, Sec. 2.1); a slower or damped update takes a fresh one.
+    2004, Sec. 2.1); a slower or damped update takes a fresh one.  The line search measures a trial by its
+    residual norm until a full update fails, then by its natural level (module doc).
     ``kink_step(evaluation, dq)`` gives the fraction of an update just past the first kink of a force
     law along it (None if there is none before the full update): the line search's second trial.
     ``settled(iteration, q, mu, evaluation, dq, dmu, gap)`` may stop with a verdict once the next update
@@ -76,6 +82,7 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
     None when ``max_iterations`` updates did not satisfy ``check``.
     """
     norm = math.sqrt(evaluation.residual @ evaluation.residual)
+    natural = False  # set once a full update fails: the solve's line searches are natural from then on
     kept = KeptTangent() if kept is None else kept
     tangent = kept.matrix
     for iteration in range(1, max_iterations + 1):
@@ -91,18 +98,28 @@ def saddle_newton(evaluate: Callable, space, constraints: np.ndarray, target: np
             if verdict is not None:
                 return verdict
 
-        def trial(step):
+        def trial(step, level=norm, update=math.sqrt(dq @ dq), solved=tangent):
+            """The trial's merit on the scale of ``level`` (the iterate's residual norm): its residual norm until
+            a full update of this solve fails to decrease it enough, from then on its Newton correction with the
+            iterate's factorisation against the update's (natural monotonicity)."""
+            nonlocal natural
             point = (q + dq, mu + dmu) if step == 1.0 else (q + step * dq, mu + step * dmu)
             result = evaluate(*point)
-            return math.sqrt(result.residual @ result.residual), (point, result)
+            residual = math.sqrt(result.residual @ result.residual)
+            natural = natural or (step == 1.0 and not residual < (1.0 - ARMIJO) * level)
+            if not natural or update == 0.0:
+                return residual, (point, result, residual)
+            correction, _ = space.saddle_solve(solved, constraints, -result.residual,
+                                               -(constraints @ point[0] - target))
+            return level * math.sqrt(correction @ correction) / update, (point, result, residual)
 
         previous, at = norm, evaluation
         kink = (lambda: kink_step(at, dq)) if kink_step is not None else None
         limit = 1.0 if first_step is None else first_step(dq)
         if limit < 1.0:  # a move-limited step is taken as it is (see the docstring)
-            step, (norm, ((q, mu), evaluation)) = limit, trial(limit)
+            step, (_, ((q, mu), evaluation, norm)) = limit, trial(limit)
         else:
-            step, norm, ((q, mu), evaluation) = backtrack(trial, norm, 1.0, kink)
+            step, _, ((q, mu), evaluation, norm) = backtrack(trial, norm, 1.0, kink)
         if step < 1.0 or norm > reuse_rate * previous:
             tangent = kept.matrix = None
     return None

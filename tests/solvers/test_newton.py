@@ -159,3 +159,41 @@ def test_a_runs_summary_counts_every_banded_factorisation_of_its_steps(tmp_path,
     assert summary["factorisations"] == len(calls) > 0
     # a kept tangent is solved again without a new LU: fewer factorisations than Newton iterations
     assert summary["factorisations"] < summary["newton_iterations"]
+
+
+class CurvedValley:
+    """r(y) = (S (y1 - y2^2), y2 - 1): a stiff row S along a curved valley, root (1, 1).  From (0, 0.1) the full
+    Newton update lands on y2 = 1 exactly (the second row is linear) but raises |r| from 1e4 to 8.1e5: the
+    residual's 2-norm, dominated by the stiff row, rejects the update that the Newton correction J(y0)^-1 r (the
+    natural level, Deuflhard 2004, Sec. 3.3) measures as 0.88 of the update's."""
+
+    STIFF = 1e6
+
+    def __init__(self, y):
+        self.y = y.copy()
+        self.residual = np.array([self.STIFF * (y[0] - y[1] ** 2), y[1] - 1.0])
+        self.tangent = np.array([[self.STIFF, -2.0 * self.STIFF * y[1]], [0.0, 1.0]])
+
+
+def test_a_full_update_that_raises_the_residual_of_a_stiff_row_is_taken_by_its_natural_level():
+    points = []
+
+    def evaluate(y, mu):
+        points.append(y.copy())
+        return CurvedValley(y)
+
+    def check(iteration, y, mu, ev, norm, gap):
+        return (y.copy(), iteration) if norm <= 1e-9 else None
+
+    y0 = np.array([0.0, 0.1])
+    result = saddle_newton(evaluate, ModalSpace(np.eye(2)), np.zeros((0, 2)), np.zeros(0), y0, np.zeros(0),
+                           CurvedValley(y0), check, 20)
+    assert result is not None
+    (y, iterations) = result
+    assert np.allclose(y, [1.0, 1.0], atol=1e-9)
+    first = points[0]  # the first trial: the full update, to (0.19, 1)
+    assert first == pytest.approx([0.19, 1.0], abs=1e-12)
+    assert np.linalg.norm(CurvedValley(first).residual) > 50 * np.linalg.norm(CurvedValley(y0).residual)
+    # taken: the next trial starts from it (the second row stays at its root), and Newton ends in a few updates
+    assert all(p[1] == pytest.approx(1.0, abs=1e-12) for p in points[1:])
+    assert iterations <= 4
