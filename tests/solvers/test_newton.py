@@ -190,10 +190,14 @@ def test_a_full_update_that_raises_the_residual_of_a_stiff_row_is_taken_by_its_n
                            CurvedValley(y0), check, 20)
     assert result is not None
     (y, iterations) = result
+    # 1e-9: check() stops at |r| <= 1e-9, which bounds |y2 - 1| by 1e-9 (its row has unit slope) and |y1 - y2^2|
+    # by 1e-15 (the stiff row)
     assert np.allclose(y, [1.0, 1.0], atol=1e-9)
-    first = points[0]  # the first trial: the full update, to (0.19, 1)
+    first = points[0]  # the first trial: the full update, to (0.19, 1) in exact arithmetic
+    # 1e-12: the update is one 2 x 2 solve of entries up to 2e5; its round-off is ~1e-16 relative
     assert first == pytest.approx([0.19, 1.0], abs=1e-12)
     assert np.linalg.norm(CurvedValley(first).residual) > 50 * np.linalg.norm(CurvedValley(y0).residual)
-    # taken: the next trial starts from it (the second row stays at its root), and Newton ends in a few updates
+    # taken: the next trial starts from it (the second row is linear, so every later update keeps y2 = 1 up to the
+    # same round-off as above), and Newton ends in a few updates
     assert all(p[1] == pytest.approx(1.0, abs=1e-12) for p in points[1:])
     assert iterations <= 4
