@@ -653,6 +653,19 @@ class Scene:
         return float(sum(section["length"] for section in sections)) if sections else self.beam.length
 
     @property
+    def hole_at_bit(self) -> tuple[float, str]:
+        """(radius [m], the key that gives it) of the hole the bit drills: the well's hole section at the string's
+        bottom when the well gives its hole (``well.hole_radius``), else ``borehole.radius``.  The paper's bit
+        torque (21) takes it as its arm, R_bh."""
+        well = self.well
+        if not (well.hole_radius and well.hole_bottom):
+            return self.borehole.radius, "borehole.radius"
+        bottoms = list(well.hole_bottom)
+        k = next((i for i, b in enumerate(bottoms) if b >= self.string_length - DEPTH_ROUND_OFF), len(bottoms) - 1)
+        k = min(k, len(well.hole_radius) - 1)
+        return well.hole_radius[k], f"well.hole_radius[{k + 1}] (the hole at the bit)"
+
+    @property
     def beam_properties(self) -> BeamProperties:
         """The parameter object the forms take (gravity 0 when ``model.gravity`` is off); its length is the
         string's (:attr:`string_length`)."""
@@ -807,12 +820,7 @@ def _check_relations(scene: Scene) -> Scene:
                          "penetrations); give k_FS1 > 0, or set model.contact = false to leave the wall out")
     bit, drive = scene.bit_rock, scene.drive
     if bit.law == "detournay":
-        hole_at_bit, which = hole.radius, "borehole.radius"
-        if scene.well.hole_radius and scene.well.hole_bottom:  # the well's hole section at the bit
-            bottoms = list(scene.well.hole_bottom)
-            k = next((i for i, b in enumerate(bottoms) if b >= scene.string_length - DEPTH_ROUND_OFF), len(bottoms) - 1)
-            k = min(k, len(scene.well.hole_radius) - 1)
-            hole_at_bit, which = scene.well.hole_radius[k], f"well.hole_radius[{k + 1}] (the hole at the bit)"
+        hole_at_bit, which = scene.hole_at_bit
         if bit.bit_radius > hole_at_bit * (1 + 1e-9):
             raise SceneError(f"bit_rock.bit_radius = {bit.bit_radius!r} is not admissible: must be <= {which} = "
                              f"{hole_at_bit!r} (the bit cuts the hole)")

@@ -111,7 +111,7 @@ def _bit_law(scene, string: AxialTorsionalString) -> tuple[int, np.ndarray]:
     if bit.law == "detournay":
         return CUTTING, np.array([*cutting_law_constants(bit), 2.0 * math.pi / bit.blades])
     sign = LAW_SIGN[scene.law(bit.torque_law)]
-    return PAPER, np.array([bit.limit_force, bit.rate, sign * bit.friction, scene.borehole.radius, 0, 0, 0, 0, 0])
+    return PAPER, np.array([bit.limit_force, bit.rate, sign * bit.friction, scene.hole_at_bit[0], 0, 0, 0, 0, 0])
 
 
 def start(scene, string: AxialTorsionalString | None = None, dt: float | None = None,
@@ -286,7 +286,7 @@ def cycle_metrics(series: dict, rotation_speed: float, bit_area: float, steady: 
 
 def bit_area(scene) -> float:
     """The area the bit drills [m^2]: pi a^2 of the cutting bit, or of the hole for the paper's law."""
-    radius = scene.bit_rock.bit_radius if scene.bit_rock.law == "detournay" else scene.borehole.radius
+    radius = scene.bit_rock.bit_radius if scene.bit_rock.law == "detournay" else scene.hole_at_bit[0]
     return math.pi * radius**2
 
 

@@ -68,3 +68,34 @@ def test_the_regularised_sign_is_tanh_to_the_last_bit_where_it_saturates_too():
     for x in np.concatenate((ratios, -ratios)) * 1e-3:
         assert sign(x, 1e-3) == tanh(x, 1e-3)
     assert np.isnan(sign(np.nan, 1e-3))
+
+
+def test_the_paper_bit_torque_in_a_well_turns_on_the_hole_the_bit_drills():
+    """A scene whose well gives its hole leaves ``borehole.radius`` unused (95 mm by default); the bit torque (21),
+    T = -mu_BR |F_BR| R_bh xi(omega), takes the well's hole at the bit as R_bh (here 4.25 in, the build-and-hold
+    well's), in the finite-element model's law and in the axial-torsional string's compiled one.  At the bit cutting at
+    V0 and spinning at Omega, T / (-mu_BR F_BR xi(Omega)) is that radius to round-off (1e-12: one product and one
+    quotient of the same doubles)."""
+    import math
+
+    import fenics_drill as fd
+    from fenics_drill.model.axial_torsional_string import axial_torsional_string
+    from fenics_drill.model.drillstring import build_model
+    from fenics_drill.studies.stick_slip import _bit_law
+
+    scene = fd.load_scene("demos/scenes/well_build_hold.toml", [
+        "bit_rock.law='paper'", "drive.weight_on_bit='20 kN'", "model.lateral_length=0.0", "beam.elements=30"])
+    hole = 4.25 * 0.0254
+    assert scene.borehole.radius != pytest.approx(hole)  # the default, which the well leaves unused
+    v0, omega, b = scene.drive.axial_velocity, scene.drive.rotation_speed, scene.bit_rock
+    expected = -b.friction * bit_rock.bit_rock_force(v0, b.limit_force, b.rate) * float(
+        bit_rock.torque_regularisation(omega))
+    model = build_model(scene)
+    law = model.force("bit_rock")
+    rows = model.bit_rows.toarray() if hasattr(model.bit_rows, "toarray") else model.bit_rows  # q -> u(L), theta_x(L)
+    qd = np.linalg.lstsq(rows, np.array([v0, omega]), rcond=None)[0]  # the bit at (V0, Omega)
+    evaluated = law.evaluate(np.zeros(model.size), qd)
+    assert -evaluated.torque / expected == pytest.approx(hole, rel=1e-12)
+    kind, constants = _bit_law(scene, axial_torsional_string(scene))
+    force, torque, *_ = bit_rock.LAW(v0, omega, *constants[:4])
+    assert -torque / expected == pytest.approx(hole, rel=1e-12) and math.isfinite(force)

@@ -141,7 +141,7 @@ class BitRock:
 
     @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "BitRock":
-        return cls(disc, space, scene.bit_rock, scene.borehole.radius, LAW_SIGN[scene.law(scene.bit_rock.torque_law)])
+        return cls(disc, space, scene.bit_rock, scene.hole_at_bit[0], LAW_SIGN[scene.law(scene.bit_rock.torque_law)])
 
     def with_parameters(self, bit_rock) -> "BitRock":
         """A copy with other law parameters (a Monte Carlo realisation of [bit_rock])."""
