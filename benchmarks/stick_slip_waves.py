@@ -1,4 +1,4 @@
-"""The axial-torsional string's stick-slip against the torsional wave guide solved along its characteristics:
+"""The axial-torsional string's stick-slip against the wave guides solved along their characteristics:
 benchmarks/results/stick_slip_waves.md.
 
     python benchmarks/stick_slip_waves.py [--t-end 100] [--after 40]
@@ -10,7 +10,9 @@ Gamma (exp(-alpha V0) - 1) and the torsion sees a bit torque of the spin alone; 
 each element length and step of the compiled steps, and for the reference, the statistics of the limit cycle over
 [after, t_end]: the mean cycle's duration, the bit's fastest and slowest spin, the share of time stuck (spin below
 1 % of the drive's), the mean surface torque, and the wall time; Newmark's alpha (``time.newmark_alpha``, 0.015 by
-default) at 0 and 0.1 shows what the scheme's own dissipation does to the cycle.
+default) at 0 and 0.1 shows what the scheme's own dissipation does to the cycle.  Then the same string in air with
+the cutting law under its hook-load drive at two points, against the axial and torsional wave guides that meet in
+the law at the bit; the reference on three grids shows how sharply this coupled cycle is defined.
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from speed import processor  # noqa: E402
-from torsional_waves import limit_cycle_statistics, vertical_paper_law_case  # noqa: E402
+from torsional_waves import limit_cycle_statistics, vertical_cutting_law_case, vertical_paper_law_case  # noqa: E402
 
 from fenics_drill.model.axial_torsional_string import axial_torsional_string  # noqa: E402
 from fenics_drill.studies.stick_slip import default_step, start  # noqa: E402
@@ -36,6 +38,47 @@ from fenics_drill.studies.stick_slip import default_step, start  # noqa: E402
 #: (elements over 2000 m, the step as a share of the default, Newmark's alpha: time.newmark_alpha)
 GRIDS = ((100, 1.0, 0.015), (200, 1.0, 0.015), (400, 1.0, 0.015), (200, 0.5, 0.015), (200, 0.25, 0.015),
          (400, 0.25, 0.015), (200, 1.0, 0.0), (200, 1.0, 0.1))
+#: The cutting law's points (weight on bit [kN], rotation speed [rpm]) and the grids of the compiled steps there.
+CUTTING_POINTS, CUTTING_GRIDS = ((60, 120), (45, 100)), ((100, 1.0, 0.015), (200, 1.0, 0.015), (200, 0.5, 0.015))
+#: The reference's torsional cells [m] (the axial ones 1.6 times as long).
+CELLS = (1.0, 0.5, 0.25)
+HEADER = ["| model | elements or cell | step [ms] | alpha | cycle [s] | fastest spin [rad/s] | slowest spin [rad/s] | "
+          "stuck share | surface torque [N m] | wall [s] |", "|---|---|---|---|---|---|---|---|---|---|"]
+
+
+def row(name: str, grid: str, step: float, alpha: str, series: dict, rotation_speed: float, after: float,
+        wall: float) -> str:
+    s = limit_cycle_statistics(series, rotation_speed, after)
+    line = (f"| {name} | {grid} | {1e3 * step:.3f} | {alpha} | {s['period']:.4f} | {s['max_spin']:.3f} | "
+            f"{s['min_spin']:.4f} | {s['stuck_share']:.4f} | {s['surface_torque']:.1f} | {wall:.1f} |")
+    print(line, flush=True)
+    return line
+
+
+def compiled_rows(case, grids, t_end: float, after: float) -> list[str]:
+    lines = []
+    for elements, share, alpha in grids:
+        scene, _ = case(elements)
+        scene = scene.with_changes(time={"newmark_alpha": alpha})
+        clock = time.perf_counter()
+        string = axial_torsional_string(scene)
+        simulation = start(scene, string, dt=share * default_step(string))
+        series = simulation.run(t_end)
+        lines.append(row("compiled steps", str(elements), simulation.dt, f"{alpha:g}", series,
+                         scene.drive.rotation_speed, after, time.perf_counter() - clock))
+    return lines
+
+
+def reference_rows(case, t_end: float, after: float) -> list[str]:
+    lines = []
+    scene, reference = case(200)
+    torsional_speed = math.sqrt(scene.beam.young_modulus / (2 * (1 + scene.beam.poisson_ratio)) / scene.beam.density)
+    for cell in CELLS:
+        clock = time.perf_counter()
+        series = reference(t_end, cell)
+        lines.append(row("wave guides", f"{cell:g} m", cell / torsional_speed, "-", series, scene.drive.rotation_speed,
+                         after, time.perf_counter() - clock))
+    return lines
 
 
 def main() -> None:
@@ -43,37 +86,23 @@ def main() -> None:
     parser.add_argument("--t-end", type=float, default=100.0)
     parser.add_argument("--after", type=float, default=40.0)
     args = parser.parse_args()
-    lines = ["# The axial-torsional string against the torsional wave guide", "",
+    lines = ["# The axial-torsional string against the wave guides solved along their characteristics", "",
              f"Command: `python benchmarks/stick_slip_waves.py --t-end {args.t_end:g} --after {args.after:g}`. Machine: "
              f"{platform.machine()}, {os.cpu_count()} cores ({processor()}), Python {platform.python_version()}; one "
-             "process.", "",
-             "The 2000 m vertical string (demos/scenes/vertical_2000m.toml) with the paper's bit law at a held 20 m/h "
-             "and 60 rpm; statistics over "
+             "process. Statistics over whole cycles in "
              f"[{args.after:g}, {args.t_end:g}] s (tests/torsional_waves.py).", "",
-             "| model | elements | step [ms] | alpha | cycle [s] | fastest spin [rad/s] | slowest spin [rad/s] | stuck share "
-             "| surface torque [N m] | wall [s] |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
-    for elements, share, alpha in GRIDS:
-        scene, reference = vertical_paper_law_case(elements)
-        scene = scene.with_changes(time={"newmark_alpha": alpha})
-        clock = time.perf_counter()
-        string = axial_torsional_string(scene)
-        simulation = start(scene, string, dt=share * default_step(string))
-        series = simulation.run(args.t_end)
-        wall = time.perf_counter() - clock
-        s = limit_cycle_statistics(series, scene.drive.rotation_speed, args.after)
-        lines.append(f"| compiled steps | {elements} | {1e3 * simulation.dt:.3f} | {alpha:g} | {s['period']:.4f} | "
-                     f"{s['max_spin']:.3f} | {s['min_spin']:.4f} | {s['stuck_share']:.4f} | "
-                     f"{s['surface_torque']:.1f} | {wall:.1f} |")
-        print(lines[-1], flush=True)
-    clock = time.perf_counter()
-    series = reference(args.t_end)
-    wall = time.perf_counter() - clock
-    s = limit_cycle_statistics(series, scene.drive.rotation_speed, args.after)
-    grid_step = 1e3 / math.sqrt(scene.beam.young_modulus / (2 * (1 + scene.beam.poisson_ratio)) / scene.beam.density)
-    lines.append(f"| wave guide, 1 m grid | - | {grid_step:.3f} | - | {s['period']:.4f} | {s['max_spin']:.3f} | {s['min_spin']:.4f} | {s['stuck_share']:.4f} | "
-                 f"{s['surface_torque']:.1f} | {wall:.1f} |")
-    print(lines[-1])
+             "**Torsion alone**: the 2000 m vertical string (demos/scenes/vertical_2000m.toml) with the paper's bit law "
+             "at a held 20 m/h and 60 rpm.", "", *HEADER,
+             *compiled_rows(vertical_paper_law_case, GRIDS, args.t_end, args.after),
+             *reference_rows(vertical_paper_law_case, args.t_end, args.after)]
+    for weight, speed in CUTTING_POINTS:
+        def case(elements, weight=weight, speed=speed):
+            return vertical_cutting_law_case(elements, weight * 1e3, speed * math.pi / 30.0)
+
+        lines += ["", f"**The cutting law, axial and torsional**: the same string in air (Poisson ratio 0.28) under its "
+                  f"hook-load drive, {weight} kN on the bit at {speed} rpm.", "", *HEADER,
+                  *compiled_rows(case, CUTTING_GRIDS, args.t_end, args.after),
+                  *reference_rows(case, args.t_end, args.after)]
     out = ROOT / "benchmarks" / "results" / "stick_slip_waves.md"
     out.write_text("\n".join(lines) + "\n")
     print(f"-> {out}")

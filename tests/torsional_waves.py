@@ -1,4 +1,4 @@
-"""An independent reference for torsional stick-slip: the string as a torsional wave guide, solved along its
+"""Independent references for stick-slip: the string as torsional (and axial) wave guides, solved along their
 characteristics.
 
 The distributed torsional model of a drill string (the drill pipe and collars as the wave equation
@@ -10,10 +10,12 @@ down-going wave f and the up-going g travel one cell of length dx = c_T dt per s
 two sections meet they split into the transmitted and reflected waves that keep omega and M continuous; the held top
 reflects g as f = Omega - g; at the bit M = T_bit(omega), solved by Newton for the bit's spin; the mass-proportional
 damping c acts along each characteristic as df/dt = dg/dt = -c (f + g) / 2.  Without damping this is exact at the
-grid's points; the damping's step is explicit, with c dt of order 1e-6.
+grid's points; the damping's step is explicit, with c dt of order 1e-6.  :func:`axial_torsional_stick_slip` adds
+the axial guide and the cutting law at the bit (below).
 
-Nothing here uses the finite-element model: only each section's length, G J and rho I_p, the drive's speed and the
-bit law's torque scale.
+Neither integration uses the finite-element model or its laws: only each section's length, stiffnesses and inertias,
+the drive and the bit law's constants (the case builders read them from a scene; the statistics of a cycle use the
+product's definition of a cycle, the same for both series compared).
 """
 
 from __future__ import annotations
@@ -127,7 +129,235 @@ def vertical_paper_law_case(elements: int = 200):
     force = bit.limit_force * math.expm1(-bit.rate * scene.drive.axial_velocity)
     scale = bit.friction * abs(force) * scene.hole_at_bit[0]
 
-    def reference(duration: float) -> dict:
-        return torsional_stick_slip(sections, scene.drive.rotation_speed, beam.damping, scale, duration)
+    def reference(duration: float, cell: float = 1.0) -> dict:
+        return torsional_stick_slip(sections, scene.drive.rotation_speed, beam.damping, scale, duration, cell,
+                                    max(1, round(10 / cell)))
+
+    return scene, reference
+
+
+# The axial and torsional wave guides of one string, meeting at the bit in the cutting law of Richard, Germay &
+# Detournay (2007) with its regenerative delay: the distributed axial-torsional model of Germay, Denoel & Detournay
+# (J. Sound Vib. 325, 2009) and of Aarsnes & Aamo (J. Sound Vib. 360, 2016), solved along its characteristics.  The
+# axial waves (speed c_A = sqrt(E / rho)) carry v = f + g and N = E A u_x = Z_A (g - f), Z_A = A sqrt(E rho), with the
+# weight rho A g as a source: df/dt = dg/dt = (g_n - c v) / 2.  Both guides share the step; each section's length is
+# a whole number of cells of both (the string's c_A / c_T is rational: a Poisson ratio of 0.28 gives 1.6).
+
+
+@njit(cache=True)
+def _clip_ramp(x, low):
+    if x <= low:
+        return low, 0.0
+    if x >= 1.0:
+        return 1.0, 0.0
+    return x, 1.0
+
+
+@njit(cache=True)
+def _surface_at(angles, surfaces, count, feed, angle):
+    """S(angle) and its slope: linear between the recorded (angle, surface), steady drilling at ``feed`` before."""
+    if angle <= angles[0]:
+        return surfaces[0] - (angles[0] - angle) * feed, feed
+    if angle >= angles[count - 1]:
+        return surfaces[count - 1], 0.0
+    lo, hi = 0, count - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if angles[mid] <= angle:
+            lo = mid
+        else:
+            hi = mid
+    slope = (surfaces[hi] - surfaces[lo]) / (angles[hi] - angles[lo])
+    return surfaces[lo] + slope * (angle - angles[lo]), slope
+
+
+@njit(cache=True)
+def _cutting(u, v, phi, w, angles, surfaces, count, law):
+    """(W, T) of the cutting law at the bit and their derivatives by (u, v, phi, w)."""
+    blades, zeta_eps_a, eps_a2_half, contact_force, torque_arm, v_c, d_c, spin_scale, feed = law
+    passage = 2.0 * math.pi / blades
+    cut, slope = _surface_at(angles, surfaces, count, feed, phi - passage)
+    d, dd_u, dd_phi = 0.0, 0.0, 0.0
+    if u > cut:
+        d, dd_u, dd_phi = blades * (u - cut), blades, -blades * slope
+    g_v, dg_v = _clip_ramp(v / v_c, 0.0)
+    g_d, dg_d = _clip_ramp(d / d_c, 0.0)
+    contact = contact_force * g_v * g_d
+    dc_d, dc_v = contact_force * g_v * dg_d / d_c, contact_force * dg_v / v_c * g_d
+    s, ds = _clip_ramp(w / spin_scale, -1.0)
+    magnitude = eps_a2_half * d + torque_arm * contact
+    weight = zeta_eps_a * d + contact
+    dw_d, dm_d = zeta_eps_a + dc_d, eps_a2_half + torque_arm * dc_d
+    return (weight, magnitude * s, dw_d * dd_u, dc_v, dw_d * dd_phi, dm_d * dd_u * s, torque_arm * dc_v * s,
+            dm_d * dd_phi * s, magnitude * ds / spin_scale)
+
+
+@njit(cache=True)
+def _bit_residual(which, v_new, w_new, u, phi, v, w, dt, za, zt, inc_a, inc_t, angles, surfaces, count, law):
+    """Z_A (v - 2 f_A) + W (which = 0) or Z_T (w - 2 f_T) + T (1) at the step's end, and its derivative by v (0)
+    or w (1); u and phi advanced by the trapezoidal rule."""
+    u_new, phi_new = u + 0.5 * dt * (v + v_new), phi + 0.5 * dt * (w + w_new)
+    weight, torque, w_u, w_v, w_phi, t_u, t_v, t_phi, t_w = _cutting(u_new, v_new, phi_new, w_new, angles, surfaces,
+                                                                     count, law)
+    if which == 0:
+        return za * (v_new - 2.0 * inc_a) + weight, za + w_v + 0.5 * dt * w_u
+    return zt * (w_new - 2.0 * inc_t) + torque, zt + t_w + 0.5 * dt * t_phi
+
+
+@njit(cache=True)
+def _bit_root(which, v_new, w_new, u, phi, v, w, dt, za, zt, inc_a, inc_t, angles, surfaces, count, law):
+    """The root of one bit equation in its own unknown, the other held: the residual rises with it (the impedance
+    and the law's resistance), so Newton is kept inside the bracket its signs give, and bisects where it leaves it."""
+    x = v_new if which == 0 else w_new
+    low, high = -math.inf, math.inf
+    for _ in range(200):
+        r, slope = _bit_residual(which, x if which == 0 else v_new, x if which == 1 else w_new, u, phi, v, w, dt, za,
+                                 zt, inc_a, inc_t, angles, surfaces, count, law)
+        if r == 0.0:
+            return x
+        if r > 0.0:
+            high = x
+        else:
+            low = x
+        step = -r / slope if slope > 0.0 else (-1.0 if r > 0.0 else 1.0) * (1.0 + abs(x))
+        trial = x + step
+        if not (low < trial < high):
+            trial = 0.5 * (low + high) if math.isfinite(low) and math.isfinite(high) else x + 2.0 * step
+        if abs(trial - x) <= 1e-15 * (1.0 + abs(x)):
+            return trial
+        x = trial
+    return x
+
+
+@njit(cache=True)
+def _march_coupled(axial_z, torsion_z, weight_source, axial_n0, omega_top, v0, hook_load, damping, dt,
+                   steps, stride, law):
+    na, nt = axial_z.size, torsion_z.size
+    fa, ga = np.empty(na), np.empty(na)
+    for k in range(na):  # moving at V0 in the static state: v = V0, N = Z (g - f) the static force
+        fa[k] = 0.5 * (v0 - axial_n0[k] / axial_z[k])
+        ga[k] = 0.5 * (v0 + axial_n0[k] / axial_z[k])
+    ft, gt = np.full(nt, 0.5 * omega_top), np.full(nt, 0.5 * omega_top)
+    fa_next, ga_next, ft_next, gt_next = np.empty(na), np.empty(na), np.empty(nt), np.empty(nt)
+    capacity = steps + 2
+    angles, surfaces = np.empty(capacity), np.empty(capacity)
+    angles[0], surfaces[0], count = 0.0, 0.0, 1
+    u, phi, v, w = 0.0, 0.0, v0, omega_top
+    out = np.empty((steps // stride + 1, 4))
+    out[0, 0], out[0, 1], out[0, 2], out[0, 3] = 0.0, w, 0.0, v
+    half = 0.5 * damping * dt
+    for step in range(1, steps + 1):
+        for k in range(na):
+            change = weight_source[k] * 0.5 * dt - half * (fa[k] + ga[k])
+            fa[k] += change
+            ga[k] += change
+        for k in range(nt):
+            loss = half * (ft[k] + gt[k])
+            ft[k] -= loss
+            gt[k] -= loss
+        ga_top, gt_top = ga[0], gt[0]
+        fa_next[0] = ga_top - hook_load / axial_z[0]  # the hook's pull: N(0) = hook load
+        ft_next[0] = omega_top - gt_top  # the held top
+        for j in range(1, na):
+            above, below = axial_z[j - 1], axial_z[j]
+            reflected = ((above - below) * fa[j - 1] + 2.0 * below * ga[j]) / (above + below)
+            ga_next[j - 1] = reflected
+            fa_next[j] = fa[j - 1] + reflected - ga[j]
+        for j in range(1, nt):
+            above, below = torsion_z[j - 1], torsion_z[j]
+            reflected = ((above - below) * ft[j - 1] + 2.0 * below * gt[j]) / (above + below)
+            gt_next[j - 1] = reflected
+            ft_next[j] = ft[j - 1] + reflected - gt[j]
+        za, zt, inc_a, inc_t = axial_z[na - 1], torsion_z[nt - 1], fa[na - 1], ft[nt - 1]
+        v_new, w_new = v, w
+        for _ in range(100):  # Gauss-Seidel over the two monotone equations, each solved bracketed
+            v_old, w_old = v_new, w_new
+            v_new = _bit_root(0, v_new, w_new, u, phi, v, w, dt, za, zt, inc_a, inc_t, angles, surfaces, count, law)
+            w_new = _bit_root(1, v_new, w_new, u, phi, v, w, dt, za, zt, inc_a, inc_t, angles, surfaces, count, law)
+            if abs(v_new - v_old) <= 1e-13 * (1.0 + abs(v_new)) and abs(w_new - w_old) <= 1e-13 * (1.0 + abs(w_new)):
+                break
+        u, phi = u + 0.5 * dt * (v + v_new), phi + 0.5 * dt * (w + w_new)
+        v, w = v_new, w_new
+        ga_next[na - 1], gt_next[nt - 1] = v - inc_a, w - inc_t
+        if phi > angles[count - 1]:  # the blade at phi leaves what it met, or deeper
+            met, _ = _surface_at(angles, surfaces, count, law[8], phi - 2.0 * math.pi / law[0])
+            angles[count], surfaces[count] = phi, max(u, met)
+            count += 1
+        top_torque = -torsion_z[0] * (gt_top - ft_next[0])
+        for k in range(na):
+            fa[k], ga[k] = fa_next[k], ga_next[k]
+        for k in range(nt):
+            ft[k], gt[k] = ft_next[k], gt_next[k]
+        if step % stride == 0:
+            row = step // stride
+            out[row, 0], out[row, 1], out[row, 2], out[row, 3] = step * dt, w, top_torque, v
+    return out
+
+
+def axial_torsional_stick_slip(sections, rotation_speed: float, axial_velocity: float, hook_load: float,
+                               weight_on_bit: float, damping: float, gravity: float, law: tuple, duration: float,
+                               cell: float = 1.0, stride: int = 10) -> dict:
+    """The bit's spin and velocity and the drive's torque over ``duration`` [s], every ``stride`` steps, from the
+    string's static state under ``weight_on_bit`` [N] moving at (``axial_velocity``, ``rotation_speed``), its top
+    pulled with ``hook_load`` [N] and turned at the held speed, the bit in the cutting law ``law`` = (n, zeta eps a,
+    eps a^2 / 2, sigma a l, mu gamma a / 2, v_c, d_c, v_c / a) over a bottom drilled steadily before t = 0.
+    ``sections``: (length, E A, rho A, G J, rho I_p) from the top down, one ratio c_A / c_T that makes every length a
+    whole number of both guides' cells (``cell`` [m] the torsional one)."""
+    torsional_speed = math.sqrt(sections[0][3] / sections[0][4])
+    dt = cell / torsional_speed
+    axial_z, torsion_z, source, static = [], [], [], []
+    tension = -weight_on_bit  # N at the bit, growing with the weight of each section above it
+    axial_cell = math.sqrt(sections[0][1] / sections[0][2]) * dt
+    layout = []
+    for length, axial, axial_mass, torsion, torsion_inertia in sections:
+        cells_a, cells_t = round(length / axial_cell), round(length / cell)
+        if abs(cells_a * axial_cell - length) > 1e-6 * length or abs(cells_t * cell - length) > 1e-6 * length:
+            raise ValueError(f"a section of {length} m is not a whole number of cells ({axial_cell} m, {cell} m)")
+        layout.append((cells_a, axial, axial_mass))
+        torsion_z += [math.sqrt(torsion * torsion_inertia)] * cells_t
+    for cells_a, axial, axial_mass in reversed(layout):  # the static force from the bit up, at each cell's middle
+        for k in range(cells_a):
+            static.append(tension + axial_mass * gravity * (k + 0.5) * axial_cell)
+        tension += axial_mass * gravity * cells_a * axial_cell
+    static.reverse()
+    for cells_a, axial, axial_mass in layout:
+        axial_z += [math.sqrt(axial * axial_mass)] * cells_a
+        source += [gravity] * cells_a
+    feed = axial_velocity / rotation_speed
+    rows = _march_coupled(np.array(axial_z), np.array(torsion_z), np.array(source), np.array(static),
+                          rotation_speed, axial_velocity, hook_load, damping, dt, int(round(duration / dt)), stride,
+                          np.array([*law, feed]))
+    return {"time": rows[:, 0], "bit_angular_velocity": rows[:, 1], "top_torque": rows[:, 2],
+            "bit_velocity": rows[:, 3]}
+
+
+def vertical_cutting_law_case(elements: int = 200, weight_on_bit: float = 60e3, rotation_speed: float = 4.0 * math.pi):
+    """(scene, reference): demos/scenes/vertical_2000m.toml with the cutting law under its hook-load drive, in air, of a
+    steel whose Poisson ratio 0.28 makes c_A / c_T = 1.6 (the guides' cells 1.6 m and 1 m fit every section), and
+    ``reference(duration, cell)``: :func:`axial_torsional_stick_slip` of its sections, the hook load the string's weight
+    less ``weight_on_bit`` [N], turned at ``rotation_speed`` [rad/s]."""
+    import fenics_drill as fd
+
+    scene = fd.load_scene("demos/scenes/vertical_2000m.toml", [
+        "beam.poisson_ratio=0.28", "fluid.density=0", f"beam.elements={elements}",
+        f"drive.weight_on_bit={weight_on_bit}", f"drive.rotation_speed={rotation_speed}"])
+    beam, bit = scene.beam, scene.bit_rock
+    shear = beam.young_modulus / (2.0 * (1.0 + beam.poisson_ratio))
+    sections, weight = [], 0.0
+    for section in reversed(scene.string.sections):
+        outer, inner = section["outer_radius"], section["inner_radius"]
+        area, polar = math.pi * (outer**2 - inner**2), math.pi / 2.0 * (outer**4 - inner**4)
+        sections.append((section["length"], beam.young_modulus * area, beam.density * area, shear * polar,
+                         beam.density * polar))
+        weight += beam.density * area * section["length"] * scene.environment.gravity
+    a = bit.bit_radius
+    law = (float(bit.blades), bit.cutting_orientation * bit.specific_energy * a, bit.specific_energy * a * a / 2.0,
+           bit.contact_strength * a * bit.wear_flat_length, bit.friction * bit.geometry_factor * a / 2.0,
+           bit.contact_velocity, bit.contact_depth, bit.contact_velocity / a)
+
+    def reference(duration: float, cell: float = 1.0) -> dict:
+        return axial_torsional_stick_slip(sections, rotation_speed, scene.drive.axial_velocity,
+                                          weight - weight_on_bit, weight_on_bit, beam.damping,
+                                          scene.environment.gravity, law, duration, cell, max(1, round(10 / cell)))
 
     return scene, reference
