@@ -69,11 +69,11 @@ def compiled_rows(case, grids, t_end: float, after: float) -> list[str]:
     return lines
 
 
-def reference_rows(case, t_end: float, after: float) -> list[str]:
+def reference_rows(case, t_end: float, after: float, cells=CELLS) -> list[str]:
     lines = []
     scene, reference = case(200)
     torsional_speed = math.sqrt(scene.beam.young_modulus / (2 * (1 + scene.beam.poisson_ratio)) / scene.beam.density)
-    for cell in CELLS:
+    for cell in cells:
         clock = time.perf_counter()
         series = reference(t_end, cell)
         lines.append(row("wave guides", f"{cell:g} m", cell / torsional_speed, "-", series, scene.drive.rotation_speed,
@@ -95,6 +95,13 @@ def main() -> None:
              "at a held 20 m/h and 60 rpm.", "", *HEADER,
              *compiled_rows(vertical_paper_law_case, GRIDS, args.t_end, args.after),
              *reference_rows(vertical_paper_law_case, args.t_end, args.after)]
+    for controller in ("pi", "soft_torque"):
+        def case(elements, controller=controller):
+            return vertical_paper_law_case(elements, controller)
+
+        lines += ["", f"**Torsion alone, a top drive**: the same, turned by `drive.controller = '{controller}'`.", "",
+                  *HEADER, *compiled_rows(case, GRIDS[1:2], args.t_end, args.after),
+                  *reference_rows(case, args.t_end, args.after, CELLS[:2])]
     for weight, speed in CUTTING_POINTS:
         def case(elements, weight=weight, speed=speed):
             return vertical_cutting_law_case(elements, weight * 1e3, speed * math.pi / 30.0)

@@ -34,7 +34,7 @@ def _regularisation(omega):
 
 
 @njit(cache=True)
-def _march(impedance, omega_top, damping, dt, steps, stride, torque_scale):
+def _march(impedance, omega_top, damping, dt, steps, stride, torque_scale, drive):
     n = impedance.size
     f = np.full(n, 0.5 * omega_top)  # the string turning at Omega, untwisted: f = g = Omega / 2 in every cell
     g = np.full(n, 0.5 * omega_top)
@@ -43,13 +43,34 @@ def _march(impedance, omega_top, damping, dt, steps, stride, torque_scale):
     out[0, 0], out[0, 1], out[0, 2] = 0.0, omega_top, 0.0
     decay = 0.5 * damping * dt
     spin, row = omega_top, 1
+    inertia, k_p, k_i, t_max = drive
+    top, integral, load = omega_top, 0.0, 0.0  # a top drive's speed, speed error's integral z, and J d(top)/dt
     for step in range(1, steps + 1):
         for k in range(n):
             loss = decay * (f[k] + g[k])
             f[k] -= loss
             g[k] -= loss
         g_top = g[0]
-        f_next[0] = omega_top - g_top  # the held top
+        if inertia == 0.0:
+            f_next[0] = omega_top - g_top  # the held top
+            top_torque = -impedance[0] * (2.0 * g_top - omega_top)  # what holding it takes: -M(0)
+        else:  # J top' = T_m + M(0), M(0) = Z (2 g - top), by the trapezoidal rule with z of the same rule
+            z0 = impedance[0]
+            base = k_p * omega_top + k_i * (integral + dt * omega_top - 0.5 * dt * top)
+            motor_rate = k_p + 0.5 * k_i * dt
+            new_top = ((inertia / dt) * top + 0.5 * (base + 2.0 * z0 * g_top) + 0.5 * load) / (
+                inertia / dt + 0.5 * motor_rate + 0.5 * z0)
+            motor = base - motor_rate * new_top
+            if abs(motor) > t_max:  # at the motor's limit, z frozen
+                motor = math.copysign(t_max, motor)
+                new_top = ((inertia / dt) * top + 0.5 * (motor + 2.0 * z0 * g_top) + 0.5 * load) / (
+                    inertia / dt + 0.5 * z0)
+            else:
+                integral += dt * (omega_top - 0.5 * (top + new_top))
+            load = motor + z0 * (2.0 * g_top - new_top)
+            top = new_top
+            f_next[0] = top - g_top
+            top_torque = motor
         for j in range(1, n):  # the node between cell j - 1 (above) and cell j (below)
             above, below = impedance[j - 1], impedance[j]
             reflected = ((above - below) * f[j - 1] + 2.0 * below * g[j]) / (above + below)
@@ -63,7 +84,6 @@ def _march(impedance, omega_top, damping, dt, steps, stride, torque_scale):
             if abs(change) <= 1e-13 * (1.0 + abs(spin)):
                 break
         g_next[n - 1] = spin - incoming
-        top_torque = -impedance[0] * (g_top - f_next[0])  # what the drive applies: -M(0)
         for k in range(n):
             f[k], g[k] = f_next[k], g_next[k]
         if step % stride == 0:
@@ -73,12 +93,15 @@ def _march(impedance, omega_top, damping, dt, steps, stride, torque_scale):
 
 
 def torsional_stick_slip(sections, rotation_speed: float, damping: float, torque_scale: float, duration: float,
-                         cell: float = 1.0, stride: int = 10) -> dict:
+                         cell: float = 1.0, stride: int = 10, top_drive: tuple = (0.0, 0.0, 0.0, math.inf)) -> dict:
     """The bit's spin and the drive's torque over ``duration`` [s] from the string turning untwisted at
     ``rotation_speed`` [rad/s], every ``stride`` steps: {"time", "bit_angular_velocity", "top_torque"}.
 
     ``sections``: (length [m], G J [N m^2], rho I_p [kg m]) from the top down, one wave speed; ``damping``: c [1/s];
-    the bit's torque -``torque_scale`` xi(omega) [N m]; ``cell``: the grid's dx [m], which divides every length."""
+    the bit's torque -``torque_scale`` xi(omega) [N m]; ``cell``: the grid's dx [m], which divides every length;
+    ``top_drive``: (J [kg m^2], k_p [N m s/rad], k_i [N m/rad], T_max [N m]) of a top drive turned by the motor torque
+    T_m = k_p (Omega - top) + k_i z, z the speed error's integral, frozen while |T_m| is at T_max (J = 0: the top
+    held at Omega); the top torque is then T_m."""
     speeds = [math.sqrt(rigidity / inertia) for _, rigidity, inertia in sections]
     if max(speeds) - min(speeds) > 1e-9 * max(speeds):
         raise ValueError("the sections' torsional wave speeds differ: the grid needs one")
@@ -89,7 +112,8 @@ def torsional_stick_slip(sections, rotation_speed: float, damping: float, torque
             raise ValueError(f"a cell of {cell} m does not divide a section of {length} m")
         impedance += [math.sqrt(rigidity * inertia)] * cells
     dt = cell / speeds[0]
-    rows = _march(np.array(impedance), rotation_speed, damping, dt, int(round(duration / dt)), stride, torque_scale)
+    rows = _march(np.array(impedance), rotation_speed, damping, dt, int(round(duration / dt)), stride, torque_scale,
+                  np.array(top_drive, dtype=float))
     return {"time": rows[:, 0], "bit_angular_velocity": rows[:, 1], "top_torque": rows[:, 2]}
 
 
@@ -110,28 +134,40 @@ def limit_cycle_statistics(series: dict, rotation_speed: float, after: float) ->
             "surface_torque": float(np.trapezoid(torque, t) / span), "cycles": len(whole)}
 
 
-def vertical_paper_law_case(elements: int = 200):
+def vertical_paper_law_case(elements: int = 200, controller: str = "stiff"):
     """(scene, reference): demos/scenes/vertical_2000m.toml (1800 m of 5 in drill pipe over 200 m of 6 3/4 in collars,
     ``elements`` over its length) drilling with the paper's bit law at its held V0 = 20 m/h and 60 rpm, where the bit
     force settles at F = Gamma (exp(-alpha V0) - 1) (the axial and torsional fields meet only in the bit torque
-    without a wall), and ``reference(duration)``: :func:`torsional_stick_slip` of its sections (G J and rho I_p of
-    St-Venant's round tubes, G = E / (2 (1 + nu))) under the torque mu |F| R_bh xi(omega), R_bh the hole at the bit."""
+    without a wall), turned by ``controller`` (``drive.controller``), and ``reference(duration, cell)``:
+    :func:`torsional_stick_slip` of its sections (G J and rho I_p of St-Venant's round tubes, G = E / (2 (1 + nu)))
+    under the torque mu |F| R_bh xi(omega), R_bh the hole at the bit, with the scene's top drive: its J_td, T_max and
+    gains, or for 'soft_torque' k_p = rho I_p c_T of the top section and k_i = (2 pi c_T / 4 L)^2 J_td (Kyllingstad &
+    Nessjoen 2009)."""
     import fenics_drill as fd
 
     scene = fd.load_scene("demos/scenes/vertical_2000m.toml", [
-        "bit_rock.law='paper'", "drive.mode='velocity'", "drive.weight_on_bit='26 kN'", f"beam.elements={elements}"])
-    beam, bit = scene.beam, scene.bit_rock
+        "bit_rock.law='paper'", "drive.mode='velocity'", "drive.weight_on_bit='26 kN'", f"beam.elements={elements}",
+        f"drive.controller='{controller}'"])
+    beam, bit, drive = scene.beam, scene.bit_rock, scene.drive
     shear = beam.young_modulus / (2.0 * (1.0 + beam.poisson_ratio))
     sections = []
     for section in reversed(scene.string.sections):  # the scene lists them from the bit up
         polar = math.pi / 2.0 * (section["outer_radius"] ** 4 - section["inner_radius"] ** 4)
         sections.append((section["length"], shear * polar, beam.density * polar))
-    force = bit.limit_force * math.expm1(-bit.rate * scene.drive.axial_velocity)
+    force = bit.limit_force * math.expm1(-bit.rate * drive.axial_velocity)
     scale = bit.friction * abs(force) * scene.hole_at_bit[0]
+    top_drive = (0.0, 0.0, 0.0, math.inf)
+    if controller == "pi":
+        top_drive = (drive.top_drive_inertia, drive.proportional_gain, drive.integral_gain, drive.torque_limit)
+    elif controller == "soft_torque":
+        speed = math.sqrt(sections[0][1] / sections[0][2])
+        quarter_wave = 2.0 * math.pi * speed / (4.0 * sum(length for length, _, _ in sections))
+        top_drive = (drive.top_drive_inertia, sections[0][2] * speed, quarter_wave**2 * drive.top_drive_inertia,
+                     drive.torque_limit)
 
     def reference(duration: float, cell: float = 1.0) -> dict:
-        return torsional_stick_slip(sections, scene.drive.rotation_speed, beam.damping, scale, duration, cell,
-                                    max(1, round(10 / cell)))
+        return torsional_stick_slip(sections, drive.rotation_speed, beam.damping, scale, duration, cell,
+                                    max(1, round(10 / cell)), top_drive)
 
     return scene, reference
 
