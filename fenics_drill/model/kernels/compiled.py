@@ -96,13 +96,17 @@ def kernel(function=None, *, fastmath=False):
     if function is None:
         return functools.partial(kernel, fastmath=fastmath)
     compiled = njit(cache=True, fastmath=set(fastmath) if fastmath else False)(function)
+    loaded = False  # whether this process has called it once (asking Numba for its signatures costs ~10 us a call)
 
     @functools.wraps(function)
     def call(*args):
+        nonlocal loaded
         try:
-            if not compiled.signatures:  # its first call in this process compiles it, or loads it from the cache
+            if not loaded:  # its first call in this process compiles it, or loads it from the cache
                 with compiling():
-                    return compiled(*args)
+                    out = compiled(*args)
+                loaded = True
+                return out
             return compiled(*args)
         except SystemError as error:
             if interrupt_in(error) is None:
