@@ -38,8 +38,8 @@ demo-as-printed: setup
 reproduction: setup
 	$(PY) benchmarks/reproduction.py --ranks $(RANKS)
 
-## The test suite (577 tests on 2 cores, AMD EPYC, Python 3.13: pytest reported 849 s with a one-core benchmark
-## running beside it; 551 s for 574 of them while benchmarks/speed.py's machine unit measured 9-11 ms on this host).
+## The test suite (581 tests on 2 cores, AMD EPYC, Python 3.13: pytest reported 645 s; 849 s for 577 of them with a
+## one-core benchmark running beside it).
 test: setup
 	$(PY) -m pytest -q tests
 
