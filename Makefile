@@ -38,8 +38,7 @@ demo-as-printed: setup
 reproduction: setup
 	$(PY) benchmarks/reproduction.py --ranks $(RANKS)
 
-## The test suite (581 tests on 2 cores, AMD EPYC, Python 3.13: pytest reported 645 s; 849 s for 577 of them with a
-## one-core benchmark running beside it).
+## The test suite (581 tests on 2 cores, AMD EPYC, Python 3.13: pytest reported 645 s).
 test: setup
 	$(PY) -m pytest -q tests
 
