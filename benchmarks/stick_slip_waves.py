@@ -12,7 +12,8 @@ each element length and step of the compiled steps, and for the reference, the s
 1 % of the drive's), the mean surface torque, and the wall time; Newmark's alpha (``time.newmark_alpha``, 0.015 by
 default) at 0 and 0.1 shows what the scheme's own dissipation does to the cycle.  Then the same string in air with
 the cutting law under its hook-load drive at two points, against the axial and torsional wave guides that meet in
-the law at the bit; the reference on three grids shows how sharply this coupled cycle is defined.
+the law at the bit; the reference on three grids shows how sharply this coupled cycle is defined.  Last, a grid of
+weight on bit x rotation speed with the cutting law, as a stick-slip map would take it.
 """
 
 from __future__ import annotations
@@ -81,6 +82,19 @@ def reference_rows(case, t_end: float, after: float, cells=CELLS) -> list[str]:
     return lines
 
 
+#: The map's grid of the cutting law's points: weights on bit [kN], rotation speeds [rpm].
+MAP_WEIGHTS, MAP_SPEEDS = (30, 45, 60, 75), (60, 100, 140)
+#: The grid's points where the default step and the wave guides disagree on the bit's bounce, run at half the step.
+HALF_STEP_POINTS = ((45, 140), (60, 100), (75, 140))
+
+
+def _map_cell(series: dict, rotation_speed: float, after: float) -> str:
+    s = limit_cycle_statistics(series, rotation_speed, after)
+    bounce = " (bounce)" if s["min_spin"] < -0.1 * rotation_speed else ""
+    return (f"{s['period']:.2f} s, {s['max_spin']:.1f} / {s['min_spin']:.1f} rad/s, stuck {s['stuck_share']:.3f}"
+            f"{bounce}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--t-end", type=float, default=100.0)
@@ -110,6 +124,26 @@ def main() -> None:
                   f"hook-load drive, {weight} kN on the bit at {speed} rpm.", "", *HEADER,
                   *compiled_rows(case, CUTTING_GRIDS, args.t_end, args.after),
                   *reference_rows(case, args.t_end, args.after)]
+    lines += ["", "**Over weight on bit x rotation speed**: the cutting law's points as a map takes them, the compiled steps "
+              "at their defaults (10 m elements, 2 ms) against the wave guides (1 m): mean cycle [s], fastest and slowest "
+              "spin [rad/s], stuck share; \"bounce\" where the bit turns backwards faster than a tenth of the drive's "
+              "speed.", "", "| weight on bit [kN] | rotation speed [rpm] | compiled steps | wave guides |", "|---|---|---|---|"]
+    for weight in MAP_WEIGHTS:
+        for speed in MAP_SPEEDS:
+            scene, reference = vertical_cutting_law_case(200, weight * 1e3, speed * math.pi / 30.0)
+            cells = [_map_cell(series, scene.drive.rotation_speed, args.after)
+                     for series in (start(scene).run(args.t_end), reference(args.t_end))]
+            lines.append(f"| {weight} | {speed} | {cells[0]} | {cells[1]} |")
+            print(lines[-1], flush=True)
+    lines += ["", "The points where the compiled steps at their default step settle on a calm cycle and the wave guides bounce, "
+              "at half that step (1 ms):", "", "| weight on bit [kN] | rotation speed [rpm] | compiled steps, 1 ms |",
+              "|---|---|---|"]
+    for weight, speed in HALF_STEP_POINTS:
+        scene, _ = vertical_cutting_law_case(200, weight * 1e3, speed * math.pi / 30.0)
+        string = axial_torsional_string(scene)
+        series = start(scene, string, dt=0.5 * default_step(string)).run(args.t_end)
+        lines.append(f"| {weight} | {speed} | {_map_cell(series, scene.drive.rotation_speed, args.after)} |")
+        print(lines[-1], flush=True)
     out = ROOT / "benchmarks" / "results" / "stick_slip_waves.md"
     out.write_text("\n".join(lines) + "\n")
     print(f"-> {out}")
