@@ -210,7 +210,7 @@ def _surface_at(angles, surfaces, count, feed, angle):
 @njit(cache=True)
 def _cutting(u, v, phi, w, angles, surfaces, count, law):
     """(W, T) of the cutting law at the bit and their derivatives by (u, v, phi, w)."""
-    blades, zeta_eps_a, eps_a2_half, contact_force, torque_arm, v_c, d_c, spin_scale, feed = law
+    blades, zeta_eps_a, eps_a2_half, contact_force, torque_arm, v_c, d_c, spin_scale, held, feed = law
     passage = 2.0 * math.pi / blades
     cut, slope = _surface_at(angles, surfaces, count, feed, phi - passage)
     d, dd_u, dd_phi = 0.0, 0.0, 0.0
@@ -224,8 +224,9 @@ def _cutting(u, v, phi, w, angles, surfaces, count, law):
     magnitude = eps_a2_half * d + torque_arm * contact
     weight = zeta_eps_a * d + contact
     dw_d, dm_d = zeta_eps_a + dc_d, eps_a2_half + torque_arm * dc_d
-    return (weight, magnitude * s, dw_d * dd_u, dc_v, dw_d * dd_phi, dm_d * dd_u * s, torque_arm * dc_v * s,
-            dm_d * dd_phi * s, magnitude * ds / spin_scale)
+    hold = held if w < 0.0 else 0.0  # a bit held against turning backwards: a damper on its backward spin
+    return (weight, magnitude * s + hold * w, dw_d * dd_u, dc_v, dw_d * dd_phi, dm_d * dd_u * s,
+            torque_arm * dc_v * s, dm_d * dd_phi * s, magnitude * ds / spin_scale + hold)
 
 
 @njit(cache=True)
@@ -316,7 +317,7 @@ def _march_coupled(axial_z, torsion_z, weight_source, axial_n0, omega_top, v0, h
         v, w = v_new, w_new
         ga_next[na - 1], gt_next[nt - 1] = v - inc_a, w - inc_t
         if phi > angles[count - 1]:  # the blade at phi leaves what it met, or deeper
-            met, _ = _surface_at(angles, surfaces, count, law[8], phi - 2.0 * math.pi / law[0])
+            met, _ = _surface_at(angles, surfaces, count, law[9], phi - 2.0 * math.pi / law[0])
             angles[count], surfaces[count] = phi, max(u, met)
             count += 1
         top_torque = -torsion_z[0] * (gt_top - ft_next[0])
@@ -336,7 +337,8 @@ def axial_torsional_stick_slip(sections, rotation_speed: float, axial_velocity: 
     """The bit's spin and velocity and the drive's torque over ``duration`` [s], every ``stride`` steps, from the
     string's static state under ``weight_on_bit`` [N] moving at (``axial_velocity``, ``rotation_speed``), its top
     pulled with ``hook_load`` [N] and turned at the held speed, the bit in the cutting law ``law`` = (n, zeta eps a,
-    eps a^2 / 2, sigma a l, mu gamma a / 2, v_c, d_c, v_c / a) over a bottom drilled steadily before t = 0.
+    eps a^2 / 2, sigma a l, mu gamma a / 2, v_c, d_c, v_c / a, the damping c_h that holds a backward spin: the torque
+    gains -c_h omega while omega < 0) over a bottom drilled steadily before t = 0.
     ``sections``: (length, E A, rho A, G J, rho I_p) from the top down, one ratio c_A / c_T that makes every length a
     whole number of both guides' cells (``cell`` [m] the torsional one)."""
     torsional_speed = math.sqrt(sections[0][3] / sections[0][4])
@@ -367,16 +369,19 @@ def axial_torsional_stick_slip(sections, rotation_speed: float, axial_velocity: 
             "bit_velocity": rows[:, 3]}
 
 
-def vertical_cutting_law_case(elements: int = 200, weight_on_bit: float = 60e3, rotation_speed: float = 4.0 * math.pi):
+def vertical_cutting_law_case(elements: int = 200, weight_on_bit: float = 60e3, rotation_speed: float = 4.0 * math.pi,
+                              backward_spin: str = "free"):
     """(scene, reference): demos/scenes/vertical_2000m.toml with the cutting law under its hook-load drive, in air, of a
     steel whose Poisson ratio 0.28 makes c_A / c_T = 1.6 (the guides' cells 1.6 m and 1 m fit every section), and
     ``reference(duration, cell)``: :func:`axial_torsional_stick_slip` of its sections, the hook load the string's weight
-    less ``weight_on_bit`` [N], turned at ``rotation_speed`` [rad/s]."""
+    less ``weight_on_bit`` [N], turned at ``rotation_speed`` [rad/s], its bit's ``backward_spin`` free or held (by a
+    damper of 1e6 N m s on a backward spin, ``bit_rock.backward_spin``'s)."""
     import fenics_drill as fd
 
     scene = fd.load_scene("demos/scenes/vertical_2000m.toml", [
         "beam.poisson_ratio=0.28", "fluid.density=0", f"beam.elements={elements}",
-        f"drive.weight_on_bit={weight_on_bit}", f"drive.rotation_speed={rotation_speed}"])
+        f"drive.weight_on_bit={weight_on_bit}", f"drive.rotation_speed={rotation_speed}",
+        f"bit_rock.backward_spin='{backward_spin}'"])
     beam, bit = scene.beam, scene.bit_rock
     shear = beam.young_modulus / (2.0 * (1.0 + beam.poisson_ratio))
     sections, weight = [], 0.0
@@ -389,7 +394,7 @@ def vertical_cutting_law_case(elements: int = 200, weight_on_bit: float = 60e3, 
     a = bit.bit_radius
     law = (float(bit.blades), bit.cutting_orientation * bit.specific_energy * a, bit.specific_energy * a * a / 2.0,
            bit.contact_strength * a * bit.wear_flat_length, bit.friction * bit.geometry_factor * a / 2.0,
-           bit.contact_velocity, bit.contact_depth, bit.contact_velocity / a)
+           bit.contact_velocity, bit.contact_depth, bit.contact_velocity / a, 1e6 if backward_spin == "held" else 0.0)
 
     def reference(duration: float, cell: float = 1.0) -> dict:
         return axial_torsional_stick_slip(sections, rotation_speed, scene.drive.axial_velocity,

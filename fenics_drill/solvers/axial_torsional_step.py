@@ -141,9 +141,9 @@ def _residual(mass, damping, stiffness, base, w, gravity, top, bit, wall_dofs, n
         tangent[bt, w] -= c_v * d_torque_w
     elif bit_kind == CUTTING:
         cut, slope = _previous_pass(surface, int(surface_state[0]), surface_state[1] > 0.5, surface_state[2],
-                                    bit_law[8], x[bt])
+                                    bit_law[9], x[bt])
         law = cutting_law(x[bu], vel[bu], vel[bt], cut, slope, bit_law[0], bit_law[1], bit_law[2], bit_law[3],
-                          bit_law[4], bit_law[5], bit_law[6], bit_law[7])
+                          bit_law[4], bit_law[5], bit_law[6], bit_law[7], bit_law[8])
         depth, bit_force, bit_torque = law[0], law[1], law[2]
         tangent[bu, w] -= law[3] + c_v * law[7]
         tangent[bu, bt - bu + w] -= law[4]
@@ -262,7 +262,7 @@ def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, a
             v[:] = v + h * (1.0 - gamma) * a + gamma * h * acc
             a[:] = acc
             if bit_kind == CUTTING:
-                _advance_surface(surface, surface_state, bit_law[8], x[bu], x[bt])
+                _advance_surface(surface, surface_state, bit_law[9], x[bu], x[bt])
             q[:] = x
             anchor[:, 0] = x[wall_dofs[:, 0]]
             anchor[:, 1] = x[wall_dofs[:, 1]]

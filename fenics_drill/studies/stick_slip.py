@@ -106,12 +106,12 @@ def default_step(string: AxialTorsionalString) -> float:
 
 def _bit_law(scene, string: AxialTorsionalString) -> tuple[int, np.ndarray]:
     if not scene.model.bit_rock:
-        return NO_BIT, np.zeros(9)
+        return NO_BIT, np.zeros(10)
     bit = scene.bit_rock
     if bit.law == "detournay":
         return CUTTING, np.array([*cutting_law_constants(bit), 2.0 * math.pi / bit.blades])
     sign = LAW_SIGN[scene.law(bit.torque_law)]
-    return PAPER, np.array([bit.limit_force, bit.rate, sign * bit.friction, scene.hole_at_bit[0], 0, 0, 0, 0, 0])
+    return PAPER, np.array([bit.limit_force, bit.rate, sign * bit.friction, scene.hole_at_bit[0], 0, 0, 0, 0, 0, 0])
 
 
 def start(scene, string: AxialTorsionalString | None = None, dt: float | None = None,

@@ -19,7 +19,8 @@ as drilling steadily at the drive speeds (V0, Omega).
 is set-valued when the bit stops (0 <= W_f <= sigma a l) and vanishes off the bottom; here
 W_f = sigma a l clip(u_dot_bit / v_c, 0, 1) clip(d / d_c, 0, 1), and the torque opposes the spin
 through clip(omega_bit a / v_c, -1, 1).  The tangent is consistent with these piecewise-linear
-forms, including d(d)/d(phi_bit) through the surface's slope.
+forms, including d(d)/d(phi_bit) through the surface's slope.  With ``bit_rock.backward_spin = 'held'`` a damper
+:data:`HELD_BACKWARD_DAMPING` adds -c_h omega to the torque while omega < 0: the bit does not turn backwards.
 """
 
 from __future__ import annotations
@@ -62,22 +63,31 @@ def surface_at(angles, surfaces, pruned, feed, angle):
     return surfaces[k - 1] + slope * (angle - angles[k - 1]), slope
 
 
+#: ``bit_rock.backward_spin = 'held'``: the damping [N m s] that holds a bit the string turns backwards.  A backward
+#: spin of 1 rad/s would take 1 MN m, a hundred times a long string's torque: under 10 kN m the bit creeps back at
+#: 0.01 rad/s, where the distributed model of Aarsnes's published code (github.com/ulfjakob/AxialTorsionalDrillString)
+#: holds it at rest.
+HELD_BACKWARD_DAMPING = 1e6
+
+
 def cutting_law_constants(bit) -> tuple:
     """The constants of :func:`cutting_law` from the scene's [bit_rock]: (n, zeta eps a, eps a^2 / 2, sigma a l,
-    mu gamma a / 2, v_c, d_c, v_c / a)."""
+    mu gamma a / 2, v_c, d_c, v_c / a, the damping that holds a backward spin)."""
     a = bit.bit_radius
     return (float(bit.blades), bit.cutting_orientation * bit.specific_energy * a, bit.specific_energy * a * a / 2.0,
             bit.contact_strength * a * bit.wear_flat_length,  # sigma a l
             bit.friction * bit.geometry_factor * a / 2.0,  # T_f = mu gamma a W_f / 2
-            bit.contact_velocity, bit.contact_depth, bit.contact_velocity / a)
+            bit.contact_velocity, bit.contact_depth, bit.contact_velocity / a,
+            HELD_BACKWARD_DAMPING if bit.backward_spin == "held" else 0.0)
 
 
 @njit(cache=True)
 def cutting_law(u, u_dot, omega, cut, slope, blades, zeta_eps_a, eps_a2_half, contact_force, torque_arm,
-                contact_velocity, contact_depth, spin_scale):
+                contact_velocity, contact_depth, spin_scale, backward_damping):
     """The law (module doc) at the bit's (u, u_dot, omega) over the surface (``cut``, ``slope``) one blade passage
     behind: (d, force on u(L), torque on theta_x(L), d(force, torque)/d(u, phi) row by row, d force/d u_dot,
-    d torque/d u_dot, d torque/d omega); the force's derivative by omega is 0."""
+    d torque/d u_dot, d torque/d omega); the force's derivative by omega is 0.  ``backward_damping`` > 0 adds
+    -backward_damping omega to the torque while omega < 0 (``bit_rock.backward_spin = 'held'``)."""
     cutting = u > cut
     d = blades * (u - cut) if cutting else 0.0
     dd_u, dd_phi = (blades, -blades * slope) if cutting else (0.0, 0.0)  # d(d) / d(u, phi)
@@ -91,8 +101,10 @@ def cutting_law(u, u_dot, omega, cut, slope, blades, zeta_eps_a, eps_a2_half, co
     s, ds = clip_ramp(omega / spin_scale, -1.0)
     weight_by_d = zeta_eps_a + contact_by_d
     torque_by_d = (eps_a2_half + torque_arm * contact_by_d) * s
-    return (d, -weight, -magnitude * s, -weight_by_d * dd_u, -weight_by_d * dd_phi, -torque_by_d * dd_u,
-            -torque_by_d * dd_phi, -d_contact_v, -torque_arm * d_contact_v * s, -magnitude * ds / spin_scale)
+    held = backward_damping if omega < 0.0 else 0.0
+    return (d, -weight, -magnitude * s - held * omega, -weight_by_d * dd_u, -weight_by_d * dd_phi,
+            -torque_by_d * dd_u, -torque_by_d * dd_phi, -d_contact_v, -torque_arm * d_contact_v * s,
+            -magnitude * ds / spin_scale - held)
 
 
 class CutSurface:
