@@ -89,7 +89,11 @@ HALF_STEP_POINTS = ((45, 140), (60, 100), (75, 140))
 
 
 def _map_cell(series: dict, rotation_speed: float, after: float) -> str:
-    s = limit_cycle_statistics(series, rotation_speed, after)
+    try:
+        s = limit_cycle_statistics(series, rotation_speed, after)
+    except IndexError:  # fewer than two rises through the drive's speed after ``after``
+        spin = series["bit_angular_velocity"][series["time"] > after]
+        return f"no cycle: {spin.max():.1f} / {spin.min():.1f} rad/s"
     bounce = " (bounce)" if s["min_spin"] < -0.1 * rotation_speed else ""
     return (f"{s['period']:.2f} s, {s['max_spin']:.1f} / {s['min_spin']:.1f} rad/s, stuck {s['stuck_share']:.3f}"
             f"{bounce}")
@@ -131,6 +135,17 @@ def main() -> None:
     for weight in MAP_WEIGHTS:
         for speed in MAP_SPEEDS:
             scene, reference = vertical_cutting_law_case(200, weight * 1e3, speed * math.pi / 30.0)
+            cells = [_map_cell(series, scene.drive.rotation_speed, args.after)
+                     for series in (start(scene).run(args.t_end), reference(args.t_end))]
+            lines.append(f"| {weight} | {speed} | {cells[0]} | {cells[1]} |")
+            print(lines[-1], flush=True)
+    lines += ["", "The same grid with the bit held against turning backwards (`bit_rock.backward_spin = 'held'`, a damper of "
+              "1e6 N m s in both; \"no cycle\": no two rises of the spin through the drive's speed, each after a fall a "
+              "quarter of its range below it):", "", "| weight on bit [kN] | rotation speed [rpm] | compiled steps | "
+              "wave guides |", "|---|---|---|---|"]
+    for weight in MAP_WEIGHTS:
+        for speed in MAP_SPEEDS:
+            scene, reference = vertical_cutting_law_case(200, weight * 1e3, speed * math.pi / 30.0, "held")
             cells = [_map_cell(series, scene.drive.rotation_speed, args.after)
                      for series in (start(scene).run(args.t_end), reference(args.t_end))]
             lines.append(f"| {weight} | {speed} | {cells[0]} | {cells[1]} |")
