@@ -144,9 +144,8 @@ class BitRock:
     geometry_factor: float = _pos("'detournay': bit geometry factor gamma of the contact torque [-]", 1.0)
     contact_velocity: float = _pos("'detournay': velocity scale of the regularised wear-flat contact [m/s]", 1e-4)
     contact_depth: float = _pos("'detournay': depth of cut over which the wear-flat contact builds up [m]", 1e-5)
-    backward_spin: str = key("free", "'detournay': a bit that the string turns backwards: 'free' (resisted by the law "
-                             "alone) or 'held' (as distributed models of the literature hold it)",
-                             choices=("free", "held"))
+    backward_spin: str = key("free", "'detournay': a bit turned backwards: 'free' (the law resists it) or 'held' (a "
+                             "damper holds it)", choices=("free", "held"))
 
 @dataclass(frozen=True)
 class Drive:
