@@ -182,6 +182,8 @@ def vertical_paper_law_case(elements: int = 200, controller: str = "stiff"):
 
 @njit(cache=True)
 def _clip_ramp(x, low):
+    """(clip(x, low, 1), its slope): written here again, not imported from the model's law, so that the reference
+    shares no code with what it checks."""
     if x <= low:
         return low, 0.0
     if x >= 1.0:

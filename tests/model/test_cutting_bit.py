@@ -158,6 +158,8 @@ def test_a_bit_held_against_turning_backwards_keeps_the_free_law_and_a_damper_on
         a = cutting_law(state[0], state[1], omega, state[2], state[3], *free)
         b = cutting_law(state[0], state[1], omega, state[2], state[3], *held)
         extra = HELD_BACKWARD_DAMPING if omega < 0 else 0.0
+        # 1e-12: the held torque is the free one plus one product, -c_h omega, in double precision (one rounding of
+        # a sum whose terms are within a factor 1e3 of each other: 1e-13 at most)
         assert b[2] == pytest.approx(a[2] - extra * omega, rel=1e-12)
         assert b[9] == pytest.approx(a[9] - extra, rel=1e-12)
         assert b[:2] == a[:2] and b[3:9] == a[3:9]
