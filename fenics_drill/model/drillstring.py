@@ -28,8 +28,8 @@ import scipy.sparse as sp
 from fenics_drill.model.discretization import THETA_X, U, V, W, BeamDiscretization
 from fenics_drill.model.forces import ForceEvaluation, build_forces
 from fenics_drill.model.reduction.hyper_reduction import RETRAIN_ABOVE, sampling_error, train_sample
-from fenics_drill.model.internal_force import (AssembledInternalForce, ElementSample, SplitInternalForce,
-                                              internal_force)
+from fenics_drill.model.internal_force import (AssembledInternalForce, ElementSample, LateralZoneInternalForce,
+                                              SplitInternalForce, internal_force)
 from fenics_drill.model.kernels.split_band import StringSplit
 from fenics_drill.model.resolution import band_frequency
 from fenics_drill.model.operators import LinearOperators, assemble_linear
@@ -208,7 +208,7 @@ class DrillstringModel:
         (:meth:`~fenics_drill.model.forces.wall_contact.WallContact.split_over`).  Every rank steps the whole state
         alike.  ValueError where the string cannot be split (its dofs do not part at one vertex, or the drive's lie
         near the cut)."""
-        if not self.space.sparse or not isinstance(self.internal, AssembledInternalForce):
+        if not self.space.sparse or not isinstance(self.internal, (AssembledInternalForce, LateralZoneInternalForce)):
             raise ValueError("a run splits its string over MPI ranks in the full order with its nonlinear internal "
                              "force only (reduction.rule = 'none', or 'auto' where it chooses the full order; "
                              "model.geometric_nonlinearity or model.inertial_nonlinearity on)")

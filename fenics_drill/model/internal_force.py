@@ -7,6 +7,8 @@ left-hand side M a + C v + K u - F_KE - F_SE of Eqs. (43)-(49), projected as in 
   matrices M, C, K and nothing is assembled while stepping.
 * :class:`AssembledInternalForce` - the energy-derived UFL forms of
   ``forms.energies`` assembled at the current state, tangent from ``ufl.derivative``.
+* :class:`LateralZoneInternalForce` - the full order of a string whose lateral fields are held above a
+  length (``model.lateral_length``): the forms assembled where the lateral fields are solved, M, C, K above.
 
 Both give the three parts of the tangent  c_u df/dq + c_v df/dqd + c_a df/dqdd  that
 Newton combines (for Newmark: c_u = 1, c_v = gamma / (beta dt), c_a = 1 / (beta dt^2)),
@@ -29,7 +31,7 @@ from fenics_drill.forms import energies
 from fenics_drill.model.kernels.banded_saddle import SparseSum
 from fenics_drill.model.kernels.cell_kernels import CellAssembly
 from fenics_drill.model.kernels.compiled import form as compiled_form
-from fenics_drill.model.discretization import BeamDiscretization
+from fenics_drill.model.discretization import THETA_Y, THETA_Z, V, W, BeamDiscretization
 from fenics_drill.model.operators import LinearOperators
 from fenics_drill.model.kernels.packed_rows import FieldPackedRows
 
@@ -90,8 +92,11 @@ class InternalForms:
     full order; each element sample and the trainer of a sample) share them and their functions U, V, A.
     A sample is a choice of cells and their weights (:class:`SampledCoefficients`), not a form."""
 
-    def __init__(self, disc: BeamDiscretization, switches: tuple, sampled: bool, cells: np.ndarray | None = None):
-        """``cells``: the forms integrate over these elements only (a rank's share of a split string); None: all."""
+    def __init__(self, disc: BeamDiscretization, switches: tuple, sampled: bool, cells: np.ndarray | None = None,
+                 axial_torsional: bool = False):
+        """``cells``: the forms integrate over these elements only (a rank's share of a split string); None: all.
+        ``axial_torsional``: the energies of u and theta_x alone (v, w, theta_y, theta_z and their tests set to zero
+        in the UFL: the elements where the lateral fields are held, :class:`LateralZoneInternalForce`)."""
         geometric_nonlinearity, inertial_nonlinearity, kinematics, angular_velocity = switches
         p = disc.form_properties
         # Energies are polynomials of degree <= 4 in the fields up to sin/cos(theta_x):
@@ -123,9 +128,12 @@ class InternalForms:
             remainders = [force(True) - force(False) for force, on in ((inertial, inertial_nonlinearity),
                                                                         (elastic, geometric_nonlinearity)) if on]
             residual = sum(remainders[1:], remainders[0])
-        self.kinetic = compiled_form(energy(kinetic, energies.kinetic_energy_density(p, U, V, False)))
-        self.strain = compiled_form(energy(strain, energies.strain_energy_density(p, energies.strain_slots(U, p.axis), False)))
-        self.residual = compiled_form(residual)
+        kinetic = energy(kinetic, energies.kinetic_energy_density(p, U, V, False))
+        strain = energy(strain, energies.strain_energy_density(p, energies.strain_slots(U, p.axis), False))
+        if axial_torsional:  # what the forms read of the fields and tests: u and theta_x only
+            held = {f: ufl.as_vector([f[0], 0.0, 0.0, f[3], 0.0, 0.0]) for f in (U, V, A, psi)}
+            kinetic, strain, residual = (ufl.replace(form, held) for form in (kinetic, strain, residual))
+        self.kinetic, self.strain, self.residual = (compiled_form(form) for form in (kinetic, strain, residual))
         # one form per derivative df/dq, df/dqd, df/dqdd (None where the residual does not hold the field): each
         # part is assembled by a kernel of its own, not by the whole Jacobian's kernel with two coefficients zero.
         # Which fields it holds is read off the form, not by expanding the derivatives (0.2 s of UFL per string)
@@ -135,13 +143,13 @@ class InternalForms:
 
     @classmethod
     def of(cls, disc: BeamDiscretization, switches: tuple, sampled: bool,
-           cells: np.ndarray | None = None) -> "InternalForms":
+           cells: np.ndarray | None = None, axial_torsional: bool = False) -> "InternalForms":
         """The forms of a string, whole or ``sampled``, over all its elements or ``cells``: built on first use, then
         shared."""
         built = _FORMS.setdefault(disc, {})
-        key = (switches, sampled, None if cells is None else cells.tobytes())
+        key = (switches, sampled, None if cells is None else cells.tobytes(), axial_torsional)
         if key not in built:
-            built[key] = cls(disc, switches, sampled, cells)
+            built[key] = cls(disc, switches, sampled, cells, axial_torsional)
         return built[key]
 
 
@@ -166,12 +174,13 @@ class AssembledInternalForce:
     def __init__(self, disc: BeamDiscretization, space, operators: LinearOperators,
                  geometric_nonlinearity: bool, inertial_nonlinearity: bool, kinematics: str = "objective",
                  angular_velocity: str = "consistent", sample: ElementSample | None = None,
-                 cells: np.ndarray | None = None):
-        """``cells``: the force of these elements only (a rank's share of a split string, full order); None: all."""
+                 cells: np.ndarray | None = None, axial_torsional: bool = False):
+        """``cells``: the force of these elements only (a rank's share of a split string, full order); None: all.
+        ``axial_torsional``: of u and theta_x alone (:class:`InternalForms`)."""
         self.space, self.sample = space, sample
         self._field_of_dof = disc.field_of_dof
         self.switches = (geometric_nonlinearity, inertial_nonlinearity, kinematics, angular_velocity)
-        forms = InternalForms.of(disc, self.switches, sample is not None, cells)
+        forms = InternalForms.of(disc, self.switches, sample is not None, cells, axial_torsional)
         self.U, self.V, self.A = forms.functions
         self._kinetic, self._strain, self._residual, self._jacobians = (forms.kinetic, forms.strain, forms.residual,
                                                                        forms.jacobians)
@@ -489,12 +498,75 @@ class TangentEntries:
         return entries if self.space.sparse else self.space.project_matrix(entries)
 
 
+class LateralZoneInternalForce:
+    """The internal force of a full-order string whose lateral fields are held at zero on some elements (above
+    ``model.lateral_length``): there the energies (24), (30), (38) of u and theta_x alone are assembled (the same
+    forms with v, w, theta_y, theta_z and their tests set to zero, whose kernels are a fraction of the whole's),
+    and the whole forms over the others (the ``zone``: the elements with a lateral dof the space solves).  The same
+    force as :class:`AssembledInternalForce` over all elements, to round-off."""
+
+    state_dependent = True
+
+    def __init__(self, disc: BeamDiscretization, space, operators: LinearOperators, switches: tuple,
+                 zone: np.ndarray, above: np.ndarray):
+        self.switches = switches
+        self.parts = (AssembledInternalForce(disc, space, operators, *switches, cells=zone),
+                      AssembledInternalForce(disc, space, operators, *switches, cells=above, axial_torsional=True))
+
+    @staticmethod
+    def cells_of(disc: BeamDiscretization, space) -> tuple[np.ndarray, np.ndarray]:
+        """(zone, the others): the elements with a lateral dof that ``space`` solves, and those without one."""
+        cell_dofs = disc.V.dofmap.list
+        lateral = np.isin(disc.field_of_dof[cell_dofs], (V, W, THETA_Y, THETA_Z))
+        solved = (lateral & (space.position[cell_dofs] >= 0)).any(axis=1)
+        return np.flatnonzero(solved).astype(np.int32), np.flatnonzero(~solved).astype(np.int32)
+
+    def evaluate(self, q, qd, qdd) -> np.ndarray:
+        zone, above = self.parts
+        return zone.evaluate(q, qd, qdd) + above.evaluate(q, qd, qdd)
+
+    def tangent_parts(self, needed=(True, True, True)):
+        """(df/dq, df/dqd, df/dqdd) at the state of the last :meth:`evaluate` (COO: the zone's entries, then those
+        above it); None for a part not ``needed``."""
+        out = []
+        for zone, above in zip(*(part.tangent_parts(needed) for part in self.parts)):
+            if zone is None:
+                out.append(None)
+                continue
+            zone, above = sp.coo_matrix(zone), sp.coo_matrix(above)
+            out.append(sp.coo_matrix((np.concatenate((zone.data, above.data)),
+                                      (np.concatenate((zone.row, above.row)), np.concatenate((zone.col, above.col)))),
+                                     shape=zone.shape))
+        return tuple(out)
+
+    def kinetic_energy(self, q, qd) -> float:
+        return sum(part.kinetic_energy(q, qd) for part in self.parts)
+
+    def strain_energy(self, q) -> float:
+        return sum(part.strain_energy(q) for part in self.parts)
+
+    def energies(self, qs: np.ndarray, qds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic (24) and strain (30) energies of many states (rows of qs and qds)."""
+        (k1, s1), (k2, s2) = (part.energies(qs, qds) for part in self.parts)
+        return k1 + k2, s1 + s2
+
+    def damping_force(self, qd) -> np.ndarray:
+        return self.parts[0].damping_force(qd)  # (45) of the whole string
+
+
 def internal_force(disc: BeamDiscretization, space, operators: LinearOperators, model,
                    sample: ElementSample | None = None):
     """The internal force the scene's [model] switches ask for: nothing nonlinear is assembled when off;
-    with ``sample``, the nonlinear part on those elements only."""
+    with ``sample``, the nonlinear part on those elements only; in the full space of a string whose lateral
+    fields are held on some elements, the forms on the others only (:class:`LateralZoneInternalForce`)."""
     geometric, inertial = model.geometric_nonlinearity, model.inertial_nonlinearity
     if not (geometric or inertial):
         return LinearInternalForce(space, operators)
-    return AssembledInternalForce(disc, space, operators, geometric, inertial, model.kinematics,
-                                  model.angular_velocity, sample)
+    switches = (geometric, inertial, model.kinematics, model.angular_velocity)
+    if space.sparse and sample is None:
+        zone, above = LateralZoneInternalForce.cells_of(disc, space)
+        if zone.size and above.size:
+            return LateralZoneInternalForce(disc, space, operators, switches, zone, above)
+        if above.size:  # no lateral dof solved: u and theta_x's energies alone, everywhere
+            return AssembledInternalForce(disc, space, operators, *switches, axial_torsional=True)
+    return AssembledInternalForce(disc, space, operators, *switches, sample)

@@ -17,7 +17,7 @@ import zlib
 
 import numpy as np
 
-from fenics_drill.model.internal_force import AssembledInternalForce
+from fenics_drill.model.internal_force import AssembledInternalForce, LateralZoneInternalForce
 from fenics_drill.solvers.static import StaticFailure
 from fenics_drill.solvers.step_control import RunFailure
 from fenics_drill.solvers.time_loop import Simulation
@@ -40,7 +40,7 @@ def why_not_split(model) -> str | None:
     """Why ``model`` is run by the first rank alone, or None when its string is split between the ranks."""
     if not model.space.sparse:
         return "a reduced (modal) model runs on one rank"
-    if not isinstance(model.internal, AssembledInternalForce):
+    if not isinstance(model.internal, (AssembledInternalForce, LateralZoneInternalForce)):
         return "a linear model (both nonlinearities off) runs on one rank"
     return None
 

@@ -13,7 +13,9 @@ from test_modes_in_the_well import COLLAR, HEAVY_WEIGHT, PIPE, G, RHO, segments,
 import fenics_drill as fd
 from fenics_drill.cli import main
 from fenics_drill.model.discretization import DRIVE, THETA_X, THETA_Y, THETA_Z, V, W, BeamDiscretization
+from fenics_drill.model.internal_force import AssembledInternalForce, LateralZoneInternalForce, internal_force
 from fenics_drill.model.operators import assemble_linear
+from fenics_drill.model.reduction.spaces import FullSpace
 from fenics_drill.model.reduction.modes import solve_modes
 
 
@@ -39,6 +41,37 @@ def test_the_lateral_fields_are_held_above_the_lateral_length():
     assert set(lateral.tolist()) <= set(none.support_dofs.tolist())
     whole = BeamDiscretization.from_scene(scene.with_changes(model={"lateral_length": -1.0}))
     assert whole.support_dofs.size == 6  # the supports of model.supports = 'paper'
+
+
+@pytest.mark.parametrize("lateral_length, kinematics", [(60.0, "objective"), (60.0, "printed"), (0.0, "objective")])
+def test_the_split_strings_internal_force_is_the_whole_forms_to_round_off(lateral_length, kinematics):
+    """Above the lateral length the full order assembles the energies of u and theta_x alone (the forms with the
+    lateral fields and tests set to zero) and the whole forms below: at random states of the build-and-hold well's
+    full space (lateral dofs held where the length says) the force, its three tangent parts and both energies are
+    those of the whole forms over every element, to 1e-12 of their size (round-off: the same terms, summed per
+    element in another order; measured 0 on the force and the parts).  Both kinematics, whose strains differ in
+    their nonlinear terms."""
+    scene = fd.load_scene("demos/scenes/well_build_hold.toml", [
+        "beam.elements=100", f"model.lateral_length={lateral_length}", f"model.kinematics='{kinematics}'"])
+    disc = BeamDiscretization.from_scene(scene)
+    operators, space = assemble_linear(disc), FullSpace(disc)
+    split = internal_force(disc, space, operators, scene.model)
+    zone, above = LateralZoneInternalForce.cells_of(disc, space)
+    assert above.size > 0 and (zone.size > 0) == (lateral_length > 0)
+    assert isinstance(split, LateralZoneInternalForce if lateral_length > 0 else AssembledInternalForce)
+    m = scene.model
+    whole = AssembledInternalForce(disc, space, operators, m.geometric_nonlinearity, m.inertial_nonlinearity,
+                                   m.kinematics, m.angular_velocity)
+    rng = np.random.default_rng(3)
+    for size in (1e-3, 0.3):  # a drilling state's size and one where every nonlinear term counts
+        q, qd, qdd = (size * rng.standard_normal(space.size) for _ in range(3))
+        expected, got = whole.evaluate(q, qd, qdd), split.evaluate(q, qd, qdd)
+        assert np.abs(got - expected).max() <= 1e-12 * np.abs(expected).max()
+        for a, b in zip(whole.tangent_parts(), split.tangent_parts()):
+            a, b = a.tocsr(), b.tocsr()
+            assert abs(b - a).max() <= 1e-12 * abs(a).max()
+        for a, b in zip(whole.energies(q[None], qd[None]), split.energies(q[None], qd[None])):
+            assert b[0] == pytest.approx(a[0], rel=1e-12)
 
 
 @pytest.mark.parametrize("value, words", [("2000.0", "must be <= the string's length"),
