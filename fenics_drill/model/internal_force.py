@@ -167,8 +167,9 @@ class AssembledInternalForce:
 
     A modal space's force and energies come from the cells' kernels (:class:`SampledCoefficients`: all
     cells, or the sample's), a third faster than DOLFINx's assembly and projection over all cells.  Its tangents
-    over all cells, and everything of the full order, come from the same kernels over every cell, with the
-    coefficients packed by DOLFINx (:class:`TangentEntries`, :meth:`assembled_vector`).
+    over all cells come from the same kernels over every cell, with the coefficients packed by DOLFINx
+    (:class:`TangentEntries`); the full order's force and tangents from them too, with the coefficients read off
+    its state (:class:`FullSpacePacking`), and its energies from DOLFINx.
     """
 
     def __init__(self, disc: BeamDiscretization, space, operators: LinearOperators,
@@ -186,8 +187,8 @@ class AssembledInternalForce:
                                                                        forms.jacobians)
         # the dofs of the sampled cells: the only ones their kernels read
         self.dofs = None if sample is None else np.unique(disc.V.dofmap.list[sample.cells]).astype(PETSc.IntType)
-        # the cells whose kernels a modal space's force runs on from q, and their dofs (None: the functions set, their
-        # coefficients packed by DOLFINx: :meth:`assembled_vector`)
+        # the cells whose kernels a modal space's force runs on from q, and their dofs (None: the full space's, whose
+        # coefficients are read off its state: :class:`FullSpacePacking`)
         self._kernel_cells = None if space.sparse else (
             (sample.cells, self.dofs) if sample is not None else
             (np.arange(disc.elements, dtype=np.int32), np.arange(disc.ndofs)))
@@ -270,11 +271,15 @@ class AssembledInternalForce:
                 packing.row_function, packing.row_dof, packing.basis, packing.basis_by_field, cells.address,
                 cells.constants, cells.coordinates, cells.cell_dofs, cells.size)
 
+    @functools.cached_property
+    def _full_packing(self) -> "FullSpacePacking":
+        return FullSpacePacking(self._residual, (self.U, self.V, self.A), self.space)
+
     def evaluate(self, q, qd, qdd) -> np.ndarray:
         self._state = (q, qd, qdd)
-        if self._kernel_cells is None:
-            return self.space.project(self.assembled_vector(q, qd, qdd))
         state = np.concatenate((q, qd, qdd))
+        if self._kernel_cells is None:
+            return self.space.project(self._residual_cells(self._full_packing.packed(state)))
         if self.sample is None:
             return self._packing.assemble(state)
         return self._linear_rows @ state + self._packing.assemble(state)
@@ -287,13 +292,13 @@ class AssembledInternalForce:
         if self._jacobians[k] is None:
             return linear if linear is not None else self.space.zeros_matrix()
         if self.dofs is None:
-            return self._matrices[k].assemble()
+            return self._matrices[k].assemble(np.concatenate(self._state))
         return self._tangent_cells[k].assemble(np.concatenate(self._state)) + linear
 
     def tangent_parts(self, needed=(True, True, True)):
         """(df/dq, df/dqd, df/dqdd) at the state of the last :meth:`evaluate`; None for a part not
         ``needed`` (a static solve needs df/dq only: one assembly instead of three)."""
-        if self.dofs is None and self._state is not None:  # other models share the functions
+        if self.dofs is None and not self.space.sparse and self._state is not None:  # other models share them
             for function, values in zip((self.U, self.V, self.A), self._state):
                 self._set(function, values)
         return tuple(self._part(k) if want else None for k, want in enumerate(needed))
@@ -370,6 +375,70 @@ class SplitInternalForce:
         return self.whole.damping_force(qd)
 
 
+def packed_placement(form: fem.Form, functions, dofs: np.ndarray, cells: np.ndarray | None = None):
+    """Where DOLFINx packs the values of ``functions`` at ``dofs`` among the coefficients of ``form`` on ``cells``
+    (None: the form's own; what ``dolfinx.fem.pack_coefficients`` gives, cells x per cell, flattened): (a function
+    reading DOLFINx's packing there, the packing with the functions zero, and the packed entries that hold a
+    function's value at a dof: their index, function and dof's index in ``dofs``).  Found by numbering the dofs
+    1, 2, ... in each function in turn; the functions are left zero."""
+    for function in functions:
+        function.x.array[:] = 0.0
+    (key, packed), = fem.pack_coefficients(form).items()
+    if cells is None:
+        at = slice(None)
+    else:
+        position = np.full(form.mesh.topology.index_map(form.mesh.topology.dim).size_local, -1)
+        position[form._cpp_object.domains(fem.IntegralType.cell, 0)] = np.arange(len(packed))
+        at = position[cells]
+
+    def pack() -> np.ndarray:
+        return fem.pack_coefficients(form)[key][at].ravel()
+
+    offset = pack().copy()
+    rows, row_function, row_dof = [], [], []
+    for f, function in enumerate(functions):  # each dof numbered 1, 2, ...: where is it packed?
+        function.x.array[dofs] = np.arange(1, len(dofs) + 1)
+        numbered = pack() - offset
+        function.x.array[:] = 0.0
+        entries = np.flatnonzero(numbered)
+        rows.append(entries)
+        row_function.append(np.full(entries.size, f))
+        row_dof.append(np.rint(numbered[entries]).astype(np.int64) - 1)
+    rows, row_function, row_dof = (np.concatenate(a) for a in (rows, row_function, row_dof))
+    if np.unique(rows).size != rows.size:
+        raise ValueError("a packed coefficient depends on more than one function")
+    return pack, offset, rows, row_function, row_dof
+
+
+class FullSpacePacking:
+    """The packed coefficients of a form over its cells at a full-space state (q, qd, qdd stacked; the held dofs
+    zero), formed without setting the functions or DOLFINx's packing: the offset (the functions zero) plus each
+    packed value read from the state (:func:`packed_placement`, checked once against DOLFINx's packing)."""
+
+    def __init__(self, form: fem.Form, functions, space):
+        pack, self.offset, rows, row_function, row_dof = packed_placement(form, functions, np.arange(space.ndofs))
+        unknown = space.position[row_dof]
+        solved = unknown >= 0  # a held dof's value is zero: its entries keep the offset's
+        self.rows, self.index = rows[solved], row_function[solved] * space.size + unknown[solved]
+        self.cells = len(form._cpp_object.domains(fem.IntegralType.cell, 0))
+        rng = np.random.default_rng(0)
+        state = rng.standard_normal(len(functions) * space.size)
+        for function, values in zip(functions, state.reshape(len(functions), -1)):
+            function.x.array[:] = space.expand(values)
+        expected = pack()
+        for function in functions:
+            function.x.array[:] = 0.0
+        if not np.allclose(self.packed(state).ravel(), expected, rtol=1e-12,
+                           atol=1e-12 * np.abs(expected).max(initial=0.0)):  # a constant form packs nothing
+            raise ValueError("the packed coefficients are not the functions' values at the dofs")
+
+    def packed(self, state: np.ndarray) -> np.ndarray:
+        """The cells' packed coefficients (cells x per cell) at the stacked full-space ``state``."""
+        out = self.offset.copy()
+        out[self.rows] += state[self.index]
+        return out.reshape(self.cells, -1)
+
+
 class SampledCoefficients:
     """A form on the sampled cells (the force, a tangent, an energy) assembled from coefficients packed
     directly from the reduced values of its ``functions`` (q, qd, qdd of U, V, A, stacked).
@@ -386,29 +455,7 @@ class SampledCoefficients:
                  fields: np.ndarray):
         """``cells``: the sample (the form is integrated over all cells: its packing is read at these);
         ``fields``: the field of each dof (the rows are packed by it: :mod:`~fenics_drill.model.kernels.packed_rows`)."""
-        for function in functions:
-            function.x.array[:] = 0.0
-        (key, packed), = fem.pack_coefficients(form).items()
-        position = np.full(form.mesh.topology.index_map(form.mesh.topology.dim).size_local, -1)
-        position[form._cpp_object.domains(fem.IntegralType.cell, 0)] = np.arange(len(packed))
-        at = position[cells]
-
-        def pack() -> np.ndarray:
-            return fem.pack_coefficients(form)[key][at].ravel()
-
-        self.offset = pack().copy()
-        rows, row_function, row_dof = [], [], []
-        for f, function in enumerate(functions):  # each sampled dof numbered 1, 2, ...: where is it packed?
-            function.x.array[dofs] = np.arange(1, len(dofs) + 1)
-            numbered = pack() - self.offset
-            function.x.array[:] = 0.0
-            entries = np.flatnonzero(numbered)
-            rows.append(entries)
-            row_function.append(np.full(entries.size, f))
-            row_dof.append(np.rint(numbered[entries]).astype(np.int64) - 1)
-        self.rows, self.row_function, self.row_dof = (np.concatenate(a) for a in (rows, row_function, row_dof))
-        if np.unique(self.rows).size != self.rows.size:
-            raise ValueError("a packed coefficient depends on more than one function")
+        pack, self.offset, self.rows, self.row_function, self.row_dof = packed_placement(form, functions, dofs, cells)
         self.basis = np.ascontiguousarray(phi_rows)
         self.basis_by_field = FieldPackedRows.of(self.basis, fields).kernel_data()
         self.cells = CellAssembly(form, dofs, cells)
@@ -486,13 +533,17 @@ class TangentEntries:
             function.x.array[:] = values
         keep = np.flatnonzero(kept & nonzero)
         self.layout = self.cells.kept_layout(keep)
+        # the full space's coefficients packed from its state; a modal space's from the functions, set by the caller
+        self.packing = FullSpacePacking(form, functions, space) if space.sparse else None
         # scipy's index type below 2^31 unknowns: a COO matrix built on them takes them as they are, without a cast
         index = np.int32 if max(self.shape) < 2**31 else np.int64
         self.rows, self.columns = position[rows[keep]].astype(index), position[columns[keep]].astype(index)
 
-    def assemble(self):
-        """The projected form at the functions' current values (COO in the full space, dense in a modal one)."""
-        (packed,) = fem.pack_coefficients(self.form).values()
+    def assemble(self, state: np.ndarray):
+        """The projected form at the stacked full-space ``state`` (COO), or at the functions' current values in a
+        modal space (dense)."""
+        (packed,) = ((self.packing.packed(state),) if self.packing is not None
+                     else fem.pack_coefficients(self.form).values())
         entries = sp.coo_matrix((self.cells.kept_entries(packed, self.layout), (self.rows, self.columns)),
                                 shape=self.shape)
         return entries if self.space.sparse else self.space.project_matrix(entries)

@@ -126,9 +126,10 @@ def test_the_sampled_forms_projected_cell_by_cell_are_the_projections_of_their_a
 
 def test_the_full_orders_force_and_tangent_parts_are_dolfinx_assembly_of_its_forms():
     """The full order's internal force and its tangent parts df/dq, df/dqd, df/dqdd, assembled by the forms' FFCx
-    kernels in one compiled loop over the cells (coefficients packed by DOLFINx, the tangents read at the entries
-    that matter, fenics_drill/model/internal_force.py), against DOLFINx's assemble_vector and assemble_matrix of the
-    same forms at the free dofs, at three random states (displacements, rates and rotations of 0.3 in SI units:
+    kernels in one compiled loop over the cells (coefficients read off the state where DOLFINx packs them, the
+    tangents read at the entries that matter, fenics_drill/model/internal_force.py), against DOLFINx's
+    assemble_vector and assemble_matrix of the same forms, their functions set to the state, at the free dofs, at
+    three random states (displacements, rates and rotations of 0.3 in SI units:
     every polynomial and sine of the energies active).  The same element tensors summed in another order: an entry
     sums at most two cells' values, so a few ulps of the largest entry (1e-13 is about 500 eps)."""
     import dolfinx.fem.petsc as fem_petsc
@@ -139,6 +140,8 @@ def test_the_full_orders_force_and_tangent_parts_are_dolfinx_assembly_of_its_for
     for _ in range(3):
         state = [0.3 * rng.standard_normal(model.size) for _ in range(3)]
         ours = force.evaluate(*state)
+        for function, values in zip((force.U, force.V, force.A), state):
+            function.x.array[:] = space.expand(values)
         reference = space.project(fem_petsc.assemble_vector(force._residual).array)
         assert np.abs(reference).max() > 0
         # the same element vectors added in another order: an entry sums at most two cells' values, a few ulps of

@@ -157,7 +157,7 @@ class AxialTorsionalWall:
             data = np.concatenate([uu, ut, ut, tt])
             kept = (rows >= 0) & (columns >= 0)
             size = self.space.size
-            return sp.csr_matrix((data[kept], (rows[kept], columns[kept])), shape=(size, size))
+            return sp.coo_matrix((data[kept], (rows[kept], columns[kept])), shape=(size, size))
         rows = self.rows.dense()
         ru, rt = rows[:n], rows[n:]
         return (ru.T @ (uu[:, None] * ru) + ru.T @ (ut[:, None] * rt) + rt.T @ (ut[:, None] * ru)
