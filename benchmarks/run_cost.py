@@ -1,10 +1,12 @@
-"""Cost and result of one run of the paper scene: wall and CPU time, steps, Newton iterations, rop,
-efficiency, peak von Mises stress (for before/after comparisons of the solver on a noisy machine).
+"""Cost and result of one run of the paper scene, or of a scene file: wall and CPU time, steps, Newton iterations,
+rop, efficiency, peak von Mises stress (for before/after comparisons of the solver on a noisy machine).
 
     python benchmarks/run_cost.py ELEMENTS T_END RULE [SECTION.KEY=VALUE ...]
+    python benchmarks/run_cost.py --scene FILE T_END [SECTION.KEY=VALUE ...]
 
 e.g. ``python benchmarks/run_cost.py 1000 0.2 none time.dt=0.000616475`` for the full-order reference.
-Run it with ``PYTHONPATH=<a checkout of another revision>`` to measure that revision instead.
+Run it with ``PYTHONPATH=<a checkout of another revision>`` to measure that revision instead (with a link
+``fenics_drill/forms`` to its ``forms`` folder).
 """
 
 from __future__ import annotations
@@ -20,10 +22,14 @@ from fenics_drill.studies.run import run_scene
 
 
 def main() -> None:
-    elements, t_end, rule, *overrides = sys.argv[1:]
-    scene = load_scene("demos/scenes/paper.toml", [f"time.t_end={t_end}", "output.field_interval=0",
-                                                   f"reduction.rule='{rule}'", f"beam.elements={elements}",
-                                                   *overrides])
+    if sys.argv[1] == "--scene":
+        path, t_end, *overrides = sys.argv[2:]
+        scene = load_scene(path, [f"time.t_end={t_end}", "output.field_interval=0", *overrides])
+    else:
+        elements, t_end, rule, *overrides = sys.argv[1:]
+        scene = load_scene("demos/scenes/paper.toml", [f"time.t_end={t_end}", "output.field_interval=0",
+                                                       f"reduction.rule='{rule}'", f"beam.elements={elements}",
+                                                       *overrides])
     with tempfile.TemporaryDirectory() as out:
         wall, cpu = time.perf_counter(), time.process_time()
         s = run_scene(scene, out, progress=False, overwrite=True)
