@@ -216,8 +216,9 @@ class DrillstringModel:
         split.check_drive(self.constraints, self.space.band_width)
         model = copy.copy(self)
         model.space = self.space.split(split)
-        share = AssembledInternalForce(self.disc, model.space, self.operators, *self.internal.switches,
-                                       cells=split.cells)
+        share = (self.internal.over(split.cells, model.space) if isinstance(self.internal, LateralZoneInternalForce)
+                 else AssembledInternalForce(self.disc, model.space, self.operators, *self.internal.switches,
+                                             cells=split.cells))
         model.internal = SplitInternalForce(self.internal, share, comm)
         model.forces = [f.split_over(comm, split.owned_vertices) if hasattr(f, "split_over") else f
                         for f in self.forces]

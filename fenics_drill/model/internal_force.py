@@ -560,9 +560,13 @@ class LateralZoneInternalForce:
 
     def __init__(self, disc: BeamDiscretization, space, operators: LinearOperators, switches: tuple,
                  zone: np.ndarray, above: np.ndarray):
+        """``zone``, ``above``: the elements of each kind this force holds (all of the string's, or a rank's share;
+        either may be empty, not both)."""
         self.switches = switches
-        self.parts = (AssembledInternalForce(disc, space, operators, *switches, cells=zone),
-                      AssembledInternalForce(disc, space, operators, *switches, cells=above, axial_torsional=True))
+        self._built = (disc, operators)
+        self.parts = tuple(AssembledInternalForce(disc, space, operators, *switches, cells=cells,
+                                                  axial_torsional=restricted)
+                           for cells, restricted in ((zone, False), (above, True)) if cells.size)
 
     @staticmethod
     def cells_of(disc: BeamDiscretization, space) -> tuple[np.ndarray, np.ndarray]:
@@ -572,22 +576,28 @@ class LateralZoneInternalForce:
         solved = (lateral & (space.position[cell_dofs] >= 0)).any(axis=1)
         return np.flatnonzero(solved).astype(np.int32), np.flatnonzero(~solved).astype(np.int32)
 
+    def over(self, cells: np.ndarray, space) -> "LateralZoneInternalForce":
+        """The same force of ``cells`` only (a rank's share of a string split over MPI ranks), in ``space``."""
+        disc, operators = self._built
+        zone, above = self.cells_of(disc, space)
+        return LateralZoneInternalForce(disc, space, operators, self.switches, np.intersect1d(zone, cells),
+                                        np.intersect1d(above, cells))
+
     def evaluate(self, q, qd, qdd) -> np.ndarray:
-        zone, above = self.parts
-        return zone.evaluate(q, qd, qdd) + above.evaluate(q, qd, qdd)
+        return sum(part.evaluate(q, qd, qdd) for part in self.parts)
 
     def tangent_parts(self, needed=(True, True, True)):
         """(df/dq, df/dqd, df/dqdd) at the state of the last :meth:`evaluate` (COO: the zone's entries, then those
         above it); None for a part not ``needed``."""
         out = []
-        for zone, above in zip(*(part.tangent_parts(needed) for part in self.parts)):
-            if zone is None:
+        for terms in zip(*(part.tangent_parts(needed) for part in self.parts)):
+            if terms[0] is None:
                 out.append(None)
                 continue
-            zone, above = sp.coo_matrix(zone), sp.coo_matrix(above)
-            out.append(sp.coo_matrix((np.concatenate((zone.data, above.data)),
-                                      (np.concatenate((zone.row, above.row)), np.concatenate((zone.col, above.col)))),
-                                     shape=zone.shape))
+            terms = [sp.coo_matrix(term) for term in terms]
+            out.append(sp.coo_matrix((np.concatenate([t.data for t in terms]),
+                                      (np.concatenate([t.row for t in terms]), np.concatenate([t.col for t in terms]))),
+                                     shape=terms[0].shape))
         return tuple(out)
 
     def kinetic_energy(self, q, qd) -> float:
@@ -598,8 +608,8 @@ class LateralZoneInternalForce:
 
     def energies(self, qs: np.ndarray, qds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Kinetic (24) and strain (30) energies of many states (rows of qs and qds)."""
-        (k1, s1), (k2, s2) = (part.energies(qs, qds) for part in self.parts)
-        return k1 + k2, s1 + s2
+        kinetic, strain = zip(*(part.energies(qs, qds) for part in self.parts))
+        return sum(kinetic), sum(strain)
 
     def damping_force(self, qd) -> np.ndarray:
         return self.parts[0].damping_force(qd)  # (45) of the whole string

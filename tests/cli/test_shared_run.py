@@ -48,7 +48,7 @@ from fenics_drill.model.drillstring import build_model
 from fenics_drill.scene import load_scene
 
 comm = MPI.COMM_WORLD
-model = build_model(load_scene(None, ["reduction.rule=none", "beam.length=20", "beam.elements=40"]))
+model = build_model(load_scene(None, ["reduction.rule=none", "beam.length=20", "beam.elements=40", *SETTINGS]))
 split = model.split_over(comm)
 rng = np.random.default_rng(0)
 # a deflected, moving string: most vertices pressed into the wall (k = 1e10 N/m), the drive held
@@ -68,13 +68,16 @@ if comm.rank == 0:
 """
 
 
-def test_the_split_saddle_solve_equals_the_one_rank_banded_solve():
+@pytest.mark.parametrize("settings", [[], ["model.lateral_length=5"]])
+def test_the_split_saddle_solve_equals_the_one_rank_banded_solve(settings):
     """Each rank assembles half the elements; the sum of the halves is the whole residual, and the Schur
-    complement on the cut vertex gives the one-rank solution on both ranks.  Tolerances: both are direct solves of
-    one system (its band's condition number 5e10 here, measured) whose elimination orders differ only across the
-    cut: measured 1.1e-14 apart; 1e-10 leaves room for another BLAS, not for a wrong block (a transposed Schur
-    complement gave 1.6e-6)."""
-    process = subprocess.Popen([str(MPIEXEC), "-n", "2", sys.executable, "-c", "import json\n" + SPLIT_SOLVE],
+    complement on the cut vertex gives the one-rank solution on both ranks; also where the lateral fields are solved
+    over the bottom 5 m only (the ranks' halves hold the energies of u and theta_x alone above them).  Tolerances:
+    both are direct solves of one system (its band's condition number 5e10 here, measured) whose elimination orders
+    differ only across the cut: measured 1.1e-14 apart; 1e-10 leaves room for another BLAS, not for a wrong block (a
+    transposed Schur complement gave 1.6e-6)."""
+    script = f"import json\nSETTINGS = {settings!r}\n" + SPLIT_SOLVE
+    process = subprocess.Popen([str(MPIEXEC), "-n", "2", sys.executable, "-c", script],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
     code, out, err = _finished(process, 300)
     assert code == 0, err
