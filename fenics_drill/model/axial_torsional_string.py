@@ -1,8 +1,11 @@
 """The string's axial and torsional fields alone, as one narrow band: what a stick-slip study steps.
 
 With ``model.lateral_length = 0`` the string has no lateral fields: it lies on the well's axis, and its energies
-(44)-(46), (52) restricted to u and theta_x are linear in them (the forms' nonlinear terms all carry v, w, theta_y or
-theta_z).  :func:`axial_torsional_string` assembles M, C and K from those forms on the scene's own mesh and sections,
+(44)-(46), (52) restricted to u and theta_x are linear in them but for the Green-Lagrange axial strain's second-order
+terms ((u'^2 + r^2 theta_x'^2) / 2 and their products), which this band leaves out: against the linear terms they are
+of the size of the strains u' and r theta_x' themselves (steel's yield strain is 1e-3).  The finite-element run of the
+same string keeps them (:class:`~fenics_drill.model.internal_force.LateralZoneInternalForce`'s restricted forms).
+:func:`axial_torsional_string` assembles M, C and K from those forms on the scene's own mesh and sections,
 keeps the rows and columns of u and theta_x, and orders them along the string (u before theta_x at one x), which
 makes them a band of half-width 3-4 for quadratic u and linear theta_x.  The wall acts through its Coulomb friction
 at each vertex, pressed by the soft string's normal force (:func:`~fenics_drill.model.forces.axial_torsional_wall.
