@@ -71,7 +71,7 @@ def test_the_split_strings_internal_force_is_the_whole_forms_to_round_off(latera
             a, b = a.tocsr(), b.tocsr()
             assert abs(b - a).max() <= 1e-12 * abs(a).max()
         for a, b in zip(whole.energies(q[None], qd[None]), split.energies(q[None], qd[None])):
-            assert b[0] == pytest.approx(a[0], rel=1e-12)
+            assert b[0] == pytest.approx(a[0], rel=1e-12)  # the same cells' sums in two parts: round-off
 
 
 @pytest.mark.parametrize("value, words", [("2000.0", "must be <= the string's length"),
