@@ -200,6 +200,13 @@ class Output:
     von_mises: bool = key(True, "record the maximum von Mises stress over the string at every step (Eq. 100)")
 
 
+#: The axial-torsional string's element length [m] where the scene leaves it to the program: the drill pipe above the
+#: lateral length (``model.axial_torsional_element_length = 0``) and the stick-slip maps' string.  Its limit cycle is
+#: within 0.7 % in severity and 0.2 % in period of finer meshes and of the exact wave-guide solution
+#: (benchmarks/results/stick_slip.md, stick_slip_waves.md, bha_split_10s_at10.md).
+AXIAL_TORSIONAL_ELEMENT_LENGTH = 10.0
+
+
 @dataclass(frozen=True)
 class Model:
     supports: str = key("paper", "'paper': v, w, theta_y, theta_z fixed at x=0 and v, w at x=L; "
@@ -220,7 +227,9 @@ class Model:
     lateral_length: float = key(-1.0, "length above the bit whose lateral fields are solved; -1: all, 0: none [m]",
                                 lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for the whole string)")
     axial_torsional_element_length: float = key(
-        -1.0, "element length above the lateral length (u and theta_x only); -1: as below it [m]", lambda x: x == -1.0 or x > 0, "> 0 (or -1 for the lateral part's)")
+        0.0, "element length above the lateral length (u, theta_x only) [m]; 0: auto "
+        f"({AXIAL_TORSIONAL_ELEMENT_LENGTH:g} m), -1: as below it",
+        lambda x: x in (-1.0, 0.0) or x > 0, "> 0 (or 0 for auto, -1 for the lateral part's)")
 
 
 def _positions(x) -> bool:
@@ -571,7 +580,7 @@ class StickSlipMap:
                              "a non-empty list of distinct names among " + ", ".join(_CONTROLLERS))
     time_limit: float = _pos("longest drilling time run at a point before its cycle has settled [s]", 200.0)
     element_length: float = _pos("the axial-torsional string's element length (beam.elements is the lateral "
-                                 "fields') [m]", 10.0)
+                                 "fields') [m]", AXIAL_TORSIONAL_ELEMENT_LENGTH)
 
 
 @dataclass(frozen=True)
@@ -653,6 +662,19 @@ class Scene:
         """The string's length [m]: its sections' (``string.sections``), or ``beam.length``."""
         sections = self.string.sections
         return float(sum(section["length"] for section in sections)) if sections else self.beam.length
+
+    @property
+    def axial_torsional_element_length(self) -> float:
+        """The elements' length above the lateral length [m] (``model.axial_torsional_element_length``), or -1 where
+        they are the lateral part's: 'auto' (0) takes :data:`AXIAL_TORSIONAL_ELEMENT_LENGTH`, or the lateral part's
+        where those are longer (it never refines); a whole string (``model.lateral_length = -1``) has none."""
+        chosen, lateral = self.model.axial_torsional_element_length, self.model.lateral_length
+        if lateral < 0 or chosen == -1.0:
+            return -1.0
+        if chosen > 0:
+            return chosen
+        lateral_part = self.string_length / self.beam.elements
+        return AXIAL_TORSIONAL_ELEMENT_LENGTH if lateral_part < AXIAL_TORSIONAL_ELEMENT_LENGTH else -1.0
 
     @property
     def hole_at_bit(self) -> tuple[float, str]:

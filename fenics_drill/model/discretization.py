@@ -190,7 +190,7 @@ class BeamDiscretization:
         is the string's) in the hole sections of ``[well]``."""
         check_memory(scene.beam.elements, scene.beam.element_degree)
         sectioned = bool(scene.string.sections or scene.well.hole_radius)
-        lateral, coarse = scene.model.lateral_length, scene.model.axial_torsional_element_length
+        lateral, coarse = scene.model.lateral_length, scene.axial_torsional_element_length
         if not (sectioned or scene.well.survey or scene.well.md):
             return cls(scene.beam_properties, scene.beam.elements, scene.beam.element_degree, scene.model.supports,
                        scene.supports.stabilisers, lateral_length=lateral, axial_torsional_element_length=coarse)

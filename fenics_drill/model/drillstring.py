@@ -78,7 +78,7 @@ class DrillstringModel:
             if damping is not None:
                 self.forces.append(damping)
         self.drive = TopDrive.from_scene(scene, disc, space)
-        self.constraints = self.drive.constraints  # [B] of (72), k x N_red: the rows the drive holds
+        self.constraints = self.drive.constraints
         self.lateral_rows = (space.rows(disc.vertex_dofs(V)), space.rows(disc.vertex_dofs(W)))
         self.bit_rows = space.rows([disc.end_dof(U, 1), disc.end_dof(THETA_X, 1)])
         # where the step's local error is measured [m]: the lateral displacements (impacts) and, at the
@@ -144,6 +144,17 @@ class DrillstringModel:
         model = copy.copy(self)
         model.forces = [*self.forces, force]
         return model
+
+    @property
+    def constraints(self):
+        """[B] of (72), k x N_red: the rows the drive holds."""
+        return self._constraints
+
+    @constraints.setter
+    def constraints(self, rows) -> None:
+        self._constraints = rows
+        #: [B]^T, formed once (a sparse [B] would form it at every product with the multipliers)
+        self.constraints_transposed = rows.T.tocsr() if hasattr(rows, "tocsr") else np.ascontiguousarray(rows.T)
 
     @property
     def drive_rate(self) -> np.ndarray:
@@ -291,7 +302,7 @@ class DrillstringModel:
             external += evaluation.generalised
         residual = internal - external
         if mu.size:
-            residual += self.constraints.T @ mu
+            residual += self.constraints_transposed @ mu
         out = Evaluation(residual, internal, external, evaluations, drive)
         if want:
             parts = internal_parts

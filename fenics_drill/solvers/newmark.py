@@ -197,7 +197,7 @@ class NewmarkNewton:
             # the residual is measured against the forces that balance at this iterate and at the states
             # accepted before (never against a predictor's residual: an explosive predictor would make
             # any iterate look converged)
-            scale = self._scale(ev, self.model.constraints.T @ mu, self.model.mass @ ((q - q_pred) * c_a))
+            scale = self._scale(ev, self.model.constraints_transposed @ mu, self.model.mass @ ((q - q_pred) * c_a))
             norms.append(norm)
             scales.append(scale)
             if norm > self.tolerance * max(self._force_level, scale):

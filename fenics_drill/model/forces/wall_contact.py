@@ -61,7 +61,7 @@ class ProjectedLaws(Mapping):
         if self._projected is None:
             rows = self._rows
             if sp.issparse(rows.flat):
-                projected = np.asarray(rows.flat.T @ self._loads.reshape(-1, len(self.NAMES))).T
+                projected = np.asarray(rows.flat_transposed @ self._loads.reshape(-1, len(self.NAMES))).T
             else:
                 projected = _projected_laws(rows.packed.kernel_data(), rows.flat.shape[1], self._delta,
                                             self._loads)
@@ -145,6 +145,11 @@ class VertexSet:
     q_ref: np.ndarray | None = None
     column_bound: np.ndarray | None = None
     reach: float = np.inf
+
+    @functools.cached_property
+    def flat_transposed(self):
+        """``flat``'s transpose (the full space's, sparse), formed once: P^T f of the vertices' loads f."""
+        return self.flat.T.tocsr()
 
 
 class WallContact:
@@ -328,7 +333,7 @@ class WallContact:
             positions = (vertex_set.flat @ q).reshape(-1, len(FIELDS))
             rates = (vertex_set.flat @ qd).reshape(-1, len(FIELDS))
             delta, nodal, laws, potential = _vertex_loads(positions, rates, *self._law(vertex_set.vertices))
-            generalised = np.asarray(vertex_set.flat.T @ nodal.ravel())
+            generalised = np.asarray(vertex_set.flat_transposed @ nodal.ravel())
         else:
             delta, nodal, laws, potential, generalised, positions, rates = _modal_pass(
                 vertex_set.packed.kernel_data(), q.size, q, qd, *self._law(vertex_set.vertices))
