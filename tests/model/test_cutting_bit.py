@@ -166,3 +166,51 @@ def test_a_bit_held_against_turning_backwards_keeps_the_free_law_and_a_damper_on
     spins = [start(s).run(30.0)["bit_angular_velocity"] for s in (scene, held_scene)]
     assert spins[0].min() < -5.0
     assert spins[1].min() > -0.1
+
+
+def test_the_kink_step_lands_just_past_the_first_kink_of_the_laws_ramps_along_an_update(cutting_model):
+    """Newton's line search tries, after a failed full update, the step just past the first kink of the law along it
+    (:meth:`CuttingBit.kink_step`): from states in each piece of the regularised law (cutting, in the contact-velocity
+    ramp, in the spin ramp, off the surface) and updates that move the bit across one or more ramps, the branches of
+    the three clipped ramps (spin, contact velocity, depth of cut) stay those of the state on [0, s - 1e-3] and have
+    changed at s (sampled along the update: the rates move linearly with it, the depth with the surface's slope,
+    which is constant between its recorded angles); an update that crosses none gives None."""
+    scene, model = cutting_model
+    bit = model.force("bit_rock").fresh()
+    rows = bit.rows.dense()
+    bit.begin(0.0, np.zeros(model.size))
+    for a in np.linspace(0.05, 2.0, 40):
+        bit.surface.advance(a, 1e-3 * a)
+    b = scene.bit_rock
+    v_c, spin_c, d_c = b.contact_velocity, b.contact_velocity / b.bit_radius, b.contact_depth
+    pinv = np.linalg.pinv(rows)
+    c_v = 2e3  # gamma / (beta dt) at dt = 1 ms
+
+    def branches(ev):
+        (u_dot, omega), (clearance, _) = ev.rates, ev.clearance
+        return tuple(int(np.searchsorted([lo, hi], x, side="right")) for x, lo, hi in
+                     ((omega / spin_c, -1, 1), (u_dot / v_c, 0, 1), (b.blades * clearance / d_c, 0, 1)))
+
+    phi = 2.0 + PASSAGE * 0.37
+    cut = bit.surface.previous_pass(phi)[0]
+    # (u - S, u_dot, omega) at the bit, and the update's (du, dphi)
+    cases = [((2e-3, 5e-3, 6.0), (0.0, -4.0 * 6.0 / c_v)),  # spinning to backwards past both spin kinks
+             ((2e-3, 0.5 * v_c, 0.3 * spin_c), (-3.0 * v_c / c_v, 2.0 * spin_c / c_v)),  # two ramps left at once
+             ((-1e-4, -1e-3, 6.0), (2e-4, 0.0)),  # off the surface, onto it
+             ((0.5 * d_c / b.blades, 2.0 * v_c, 6.0), (-d_c / b.blades, 0.0)),  # in the depth ramp, leaving it
+             ((2e-3, 5e-3, 6.0), (0.0, 1e-4))]  # inside one piece: no kink
+    kinks = 0
+    for (over, u_dot, omega), (du, dphi) in cases:
+        q, qd = pinv @ np.array([cut + over, phi]), pinv @ np.array([u_dot, omega])
+        dq = pinv @ np.array([du, dphi])
+        ev = bit.evaluate(q, qd)
+        s = bit.kink_step(ev, dq, c_v)
+        along = [branches(bit.evaluate(q + t * dq, qd + c_v * t * dq)) for t in np.linspace(0.0, 1.0, 2001)]
+        if s is None:
+            assert len(set(along)) == 1, (over, u_dot, omega)
+            continue
+        kinks += 1
+        start = branches(ev)
+        assert branches(bit.evaluate(q + max(s - 1e-3, 0.0) * dq, qd + c_v * max(s - 1e-3, 0.0) * dq)) == start
+        assert branches(bit.evaluate(q + s * dq, qd + c_v * s * dq)) != start
+    assert kinks == 4

@@ -34,6 +34,7 @@ import numpy as np
 from numba import njit
 
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
+from fenics_drill.model.forces.bit_rock import step_past_kink
 from fenics_drill.model.forces.protocol import ForceEvaluation
 
 
@@ -173,6 +174,8 @@ class CuttingForces(ForceEvaluation):
     torque: float = 0.0  # -T, the torque on theta_x(L) [N m]
     jacobian_q: np.ndarray | None = None  # d(force, torque) / d(u, phi) at the bit
     jacobian_qd: np.ndarray | None = None  # d(force, torque) / d(u_dot, omega) at the bit
+    rates: tuple = (0.0, 0.0)  # (u_dot, omega) at the bit
+    clearance: tuple = (0.0, 0.0)  # (u - S, dS/dphi): the bit above the surface one blade passage behind, its slope
 
 
 class CuttingBit:
@@ -253,7 +256,22 @@ class CuttingBit:
         jac_qd = np.array([[law[4], 0.0], [law[5], law[6]]])
         laws = {"bit_rock_force": f_u * self._unit_loads[0], "bit_rock_torque": f_t * self._unit_loads[1]}
         generalised = laws["bit_rock_force"] + laws["bit_rock_torque"]
-        return CuttingForces(generalised, 0.0, laws, d, f_u, f_t, jac_q, jac_qd)
+        return CuttingForces(generalised, 0.0, laws, d, f_u, f_t, jac_q, jac_qd, (u_dot, omega), (u - cut, slope))
+
+    def kink_step(self, forces: CuttingForces, dq: np.ndarray, c_v: float) -> float | None:
+        """The fraction of a Newton update dq (which moves qd by c_v dq) just past the first kink of the law's clipped
+        ramps along it, linearised: the spin's at omega a = -v_c, v_c (and 0 with a held backward spin), the wear
+        flats' at u_dot = 0, v_c and at d = 0, d_c; None if it crosses none.  A full update that jumps a ramp lands
+        on a branch the tangent did not see (the stuck bit's torque ramp is v_c / a = 1e-3 rad/s wide)."""
+        du, dphi = (float(v) for v in self.rows.values(dq))
+        (u_dot, omega), (clearance, slope) = forces.rates, forces.clearance
+        blades, *_, contact_velocity, contact_depth, spin_scale, backward_damping = self.law_constants
+        spins = (-spin_scale, spin_scale, 0.0) if backward_damping > 0 else (-spin_scale, spin_scale)
+        crossings = [(omega - k, c_v * dphi) for k in spins]
+        crossings += [(u_dot - k, c_v * du) for k in (0.0, contact_velocity)]
+        crossings += [(clearance - k, du - slope * dphi) for k in (0.0, contact_depth / blades)]
+        steps = [s for s in (step_past_kink(value, change) for value, change in crossings) if s is not None]
+        return min(steps) if steps else None
 
     def tangent(self, forces: CuttingForces, c_u: float, c_v: float):
         """c_u df/dq + c_v df/dqd: the 2 x 2 law Jacobians at the bit, projected."""
