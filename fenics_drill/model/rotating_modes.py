@@ -30,6 +30,7 @@ import scipy.sparse as sp
 from petsc4py import PETSc
 from slepc4py import SLEPc
 
+from fenics_drill.model.kernels.banded_saddle import as_csr
 from fenics_drill.model.kernels.compiled import interrupt_in
 from fenics_drill.model.discretization import DRIVE, THETA_X, THETA_Y, THETA_Z, V, W, BeamDiscretization
 from fenics_drill.model.internal_force import internal_force
@@ -97,7 +98,7 @@ def linearise_about_spin(disc: BeamDiscretization, operators: LinearOperators, m
     for force in point_forces:
         tangent = force.tangent(force.evaluate(q0, np.zeros_like(q0), with_tangent=True), 1.0, 0.0)
         if tangent is not None:
-            stiffness = stiffness - sp.csr_matrix(tangent)
+            stiffness = stiffness - sp.csr_matrix(as_csr(tangent))
     damping = 0.5 * (first_order + first_order.T)
     gyroscopic = 0.5 * (first_order - first_order.T)
     return SpinLinearisation(space, mass, damping.tocsr(), gyroscopic.tocsr(), stiffness.tocsr())

@@ -22,6 +22,7 @@ from fenics_drill.model.discretization import DRIVE, THETA_X, THETA_Y, THETA_Z, 
 from fenics_drill.model.drillstring import DrillstringModel
 from fenics_drill.model.forces.axial_tip_load import AxialTipLoad
 from fenics_drill.model.forces.wall_contact import WallContact
+from fenics_drill.model.kernels.banded_saddle import as_csr
 from fenics_drill.model.operators import assemble_geometric_stiffness
 from fenics_drill.model.reduction.modes import solve_modes
 from fenics_drill.model.reduction.spaces import FullSpace
@@ -81,7 +82,7 @@ def loaded_stiffness(scene, disc, operators, state: OperatingState) -> sp.csr_ma
     space = FullSpace(disc)
     wall = WallContact.from_scene(scene, disc, space, operators)
     q = space.project(state.displacement)
-    springs = sp.csr_matrix(wall.tangent(wall.evaluate(q, np.zeros_like(q), with_tangent=True), 1.0, 0.0))
+    springs = sp.csr_matrix(as_csr(wall.tangent(wall.evaluate(q, np.zeros_like(q), with_tangent=True), 1.0, 0.0)))
     embed = sp.csr_matrix((np.ones(space.size), (space.free, np.arange(space.size))), shape=(disc.ndofs, space.size))
     return (stiffness - embed @ springs @ embed.T).tocsr()
 

@@ -20,10 +20,10 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
-import scipy.sparse as sp
 
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
+from fenics_drill.model.kernels.banded_saddle import Triplets
 from fenics_drill.model.forces.wall.coulomb import coulomb_friction
 from fenics_drill.model.soft_string import operations, soft_string, string_mesh
 from fenics_drill.model.well import string_in_well
@@ -157,7 +157,7 @@ class AxialTorsionalWall:
             data = np.concatenate([uu, ut, ut, tt])
             kept = (rows >= 0) & (columns >= 0)
             size = self.space.size
-            return sp.coo_matrix((data[kept], (rows[kept], columns[kept])), shape=(size, size))
+            return Triplets(data[kept], rows[kept], columns[kept], (size, size))
         rows = self.rows.dense()
         ru, rt = rows[:n], rows[n:]
         return (ru.T @ (uu[:, None] * ru) + ru.T @ (ut[:, None] * rt) + rt.T @ (ut[:, None] * ru)

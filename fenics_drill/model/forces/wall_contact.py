@@ -42,6 +42,7 @@ from fenics_drill.model.forces.wall.vertex_passes import (FIELDS, _contact_block
                                                           _projected_laws,
                                                           _scattered_square, _selection, _vertex_loads,
                                                           _weighted_rows)
+from fenics_drill.model.kernels.banded_saddle import Triplets
 from fenics_drill.model.kernels.packed_rows import FieldPackedRows
 from fenics_drill.scene import LAW_SIGN
 
@@ -421,7 +422,7 @@ class WallContact:
             rows, columns = np.broadcast_arrays(dofs[:, :, None], dofs[:, None, :])
             data = scale[:, :, None] * blocks * scale[:, None, :]
             kept = (rows >= 0) & (columns >= 0) & (data != 0.0)
-            return sp.coo_matrix((data[kept], (rows[kept], columns[kept])), shape=(flat.shape[1],) * 2)
+            return Triplets(data[kept], rows[kept], columns[kept], (flat.shape[1],) * 2)
         return self._updated_tangent(vertices[active], blocks)
 
     #: A vertex's block enters the modal tangent afresh when it changed by more than this share of the largest

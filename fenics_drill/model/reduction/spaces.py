@@ -15,6 +15,7 @@ u(0, t) = V0 t and theta_x(0, t) = Omega t need Lagrange multipliers (70)-(76).
 from __future__ import annotations
 
 import copy
+import functools
 
 import numpy as np
 import scipy.linalg as sla
@@ -23,7 +24,7 @@ import scipy.sparse.linalg as spla
 from scipy.linalg.lapack import dgetrf as getrf
 from scipy.linalg.lapack import dgetrs as getrs
 
-from fenics_drill.model.kernels.banded_saddle import BandedSaddle, SparseSum
+from fenics_drill.model.kernels.banded_saddle import BandedSaddle, SparseSum, Triplets
 from fenics_drill.model.kernels.split_band import SplitBandedSaddle, StringSplit
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.reduction.enrichment import MODE_SPAN_TOLERANCE, augment, climbing_friction, enrich
@@ -96,11 +97,21 @@ class SelectedPointRows:
     def unit_loads(self) -> tuple[np.ndarray, ...]:
         return tuple(self.spread(unit) for unit in np.eye(self.positions.size))
 
-    def block(self, jacobian: np.ndarray) -> sp.coo_matrix:
-        kept = np.flatnonzero(self.free)
-        rows, columns = np.meshgrid(self.positions[kept], self.positions[kept], indexing="ij")
-        data = np.asarray(jacobian, dtype=float)[np.ix_(kept, kept)]
-        return sp.coo_matrix((data.ravel(), (rows.ravel(), columns.ravel())), shape=(self.size, self.size))
+    def block(self, jacobian: np.ndarray) -> Triplets:
+        kept = self._kept
+        rows, columns = self._block_entries
+        return Triplets(np.asarray(jacobian, dtype=float)[np.ix_(kept, kept)].ravel(), rows, columns,
+                        (self.size, self.size))
+
+    @functools.cached_property
+    def _kept(self) -> np.ndarray:
+        return np.flatnonzero(self.free)
+
+    @functools.cached_property
+    def _block_entries(self) -> tuple[np.ndarray, np.ndarray]:
+        """(row, column) of each entry of a block, row by row."""
+        rows, columns = np.meshgrid(self.positions[self._kept], self.positions[self._kept], indexing="ij")
+        return rows.ravel(), columns.ravel()
 
     def subset(self, indices) -> "SelectedPointRows":
         return SelectedPointRows(self.positions[indices], self.size)
