@@ -200,10 +200,11 @@ class Output:
     von_mises: bool = key(True, "record the maximum von Mises stress over the string at every step (Eq. 100)")
 
 
-#: The axial-torsional string's element length [m] where the scene leaves it to the program: the drill pipe above the
-#: lateral length (``model.axial_torsional_element_length = 0``) and the stick-slip maps' string.  Its limit cycle is
-#: within 0.7 % in severity and 0.2 % in period of finer meshes and of the exact wave-guide solution
-#: (benchmarks/results/stick_slip.md, stick_slip_waves.md, bha_split_10s_at10.md).
+#: The axial-torsional string's element length [m] where the scene leaves it to the program: the drill pipe above a
+#: BHA's lateral length (``model.axial_torsional_element_length = 0``) and the stick-slip maps' string.  Its limit
+#: cycle is within 0.7 % in severity and 0.2 % in period of finer meshes and of the exact wave-guide solution
+#: (benchmarks/results/stick_slip.md, stick_slip_waves.md); the build-and-hold well's 150 m split within 0.7 % of its
+#: 1.8 m mesh in period, severity, torque and rop (bha_split_10s_fine_pipe.md against bha_split_10s.md).
 AXIAL_TORSIONAL_ELEMENT_LENGTH = 10.0
 
 
@@ -227,8 +228,8 @@ class Model:
     lateral_length: float = key(-1.0, "length above the bit whose lateral fields are solved; -1: all, 0: none [m]",
                                 lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for the whole string)")
     axial_torsional_element_length: float = key(
-        0.0, "element length above the lateral length (u, theta_x only) [m]; 0: auto "
-        f"({AXIAL_TORSIONAL_ELEMENT_LENGTH:g} m), -1: as below it",
+        0.0, "element length above the lateral length (u, theta_x) [m]; 0: auto "
+        f"({AXIAL_TORSIONAL_ELEMENT_LENGTH:g} m above a BHA), -1: as below",
         lambda x: x in (-1.0, 0.0) or x > 0, "> 0 (or 0 for auto, -1 for the lateral part's)")
 
 
@@ -666,13 +667,17 @@ class Scene:
     @property
     def axial_torsional_element_length(self) -> float:
         """The elements' length above the lateral length [m] (``model.axial_torsional_element_length``), or -1 where
-        they are the lateral part's: 'auto' (0) takes :data:`AXIAL_TORSIONAL_ELEMENT_LENGTH`, or the lateral part's
-        where those are longer (it never refines); a whole string (``model.lateral_length = -1``) has none."""
+        they are the lateral part's: 'auto' (0) takes :data:`AXIAL_TORSIONAL_ELEMENT_LENGTH` above a BHA's lateral
+        length, or the lateral part's where those are longer (it never refines); over a whole axial-torsional string
+        (``model.lateral_length = 0``) it keeps ``beam.elements``, whose bit and collars a 10 m mesh would coarsen (the
+        VBH well's rop over 5-10 s of its start-up moves by 9 % there); a whole string (-1) has none."""
         chosen, lateral = self.model.axial_torsional_element_length, self.model.lateral_length
         if lateral < 0 or chosen == -1.0:
             return -1.0
         if chosen > 0:
             return chosen
+        if lateral == 0:
+            return -1.0
         lateral_part = self.string_length / self.beam.elements
         return AXIAL_TORSIONAL_ELEMENT_LENGTH if lateral_part < AXIAL_TORSIONAL_ELEMENT_LENGTH else -1.0
 

@@ -87,11 +87,10 @@ def test_the_wall_friction_of_an_axial_torsional_pipe_turning_on_the_wall_is_mu_
     torque is the wall's Coulomb torque, mu w L R_ext (the normal force per length is the weight w in a straight
     horizontal hole), plus the viscous damping (38) of the turning pipe, c rho I_p Omega L (with c = 2 /s, 22 % of
     it, and the torsional oscillation damped within the run).  Mean over the last 0.5 s of 1.5 s within 1e-3
-    (measured 2.3e-4: the oscillation's residue) on 1 m elements (``model.axial_torsional_element_length = -1``: at
-    the default 10 m the start's oscillation rings at another phase, and its residue in the mean is 2.5e-3)."""
+    (measured 2.3e-4: the oscillation's residue)."""
     scene = fd.load_scene(None, ["model.lateral_length=0.0", "model.bit_rock=false", "time.t_end=1.5",
                                  "output.field_interval=0", "beam.elements=100", "contact.friction=0.25",
-                                 "beam.damping=2.0", "model.axial_torsional_element_length=-1"])
+                                 "beam.damping=2.0"])
     run = fd.run(scene)
     t, torque = run.series["time"].values, -run.series["lambda_4"].values
     late = t > 1.0
@@ -110,12 +109,9 @@ def test_the_axial_torsional_strings_modes_are_the_transfer_matrix_roots(held):
     drill pipe (500 m) hanging in a vertical well, their first three axial and torsional frequencies against the
     exact roots of the composite rod's transfer matrix (:mod:`string_references`), free at both ends, held by the
     drive at the top, or held there with the bit stuck (theta_x held at the bit).  Within 1e-4, the discretisation
-    error of 1000 elements, asked for with ``model.axial_torsional_element_length = -1`` (test_modes_in_the_well:
-    theta_x linear, (kh)^2 / 24 <= 1.1e-5 for the third mode; the default 10 m elements' error is bounded by the next
-    test)."""
+    error of 1000 elements (test_modes_in_the_well: theta_x linear, (kh)^2 / 24 <= 1.1e-5 for the third mode)."""
     sections = [COLLAR, HEAVY_WEIGHT, PIPE]
-    disc = BeamDiscretization.from_scene(vertical_string(sections, 1000, "model.lateral_length=0.0",
-                                                         "model.axial_torsional_element_length=-1"))
+    disc = BeamDiscretization.from_scene(vertical_string(sections, 1000, "model.lateral_length=0.0"))
     ends = {"free-free": (), "drive-held": DRIVE, "bit stuck": (*DRIVE, (THETA_X, 1))}[held]
     basis = solve_modes(disc, 2.0, assemble_linear(disc).mass, held=ends, vectors=False)
     assert set(basis.kinds) <= {"axial", "torsional", "rigid"}, set(basis.kinds)  # no lateral mode is left
@@ -194,7 +190,8 @@ def test_the_elements_above_the_lateral_length_take_their_own_length():
     elements (1 m), the vertices below the lateral length's top stay 1 m apart, those above are at most 10 m apart and
     still fall on every section end and survey station; -1 leaves the mesh as it was; with the whole string's
     lateral fields it is refused.  'auto' (0, the default) is 10 m, or the lateral part's elements where those are
-    longer (60 elements: 15 m)."""
+    longer (60 elements: 15 m); over a whole axial-torsional string (``model.lateral_length = 0``) it keeps
+    ``beam.elements``."""
     scene = fd.load_scene("demos/scenes/well_build_hold.toml", ["beam.elements=900", "model.lateral_length=150.0"])
     fine = BeamDiscretization.from_scene(scene.with_changes(model={"axial_torsional_element_length": -1.0})).vertex_x
     graded = BeamDiscretization.from_scene(scene.with_changes(model={"axial_torsional_element_length": 10.0})).vertex_x
@@ -207,10 +204,10 @@ def test_the_elements_above_the_lateral_length_take_their_own_length():
     for x in [*stations[stations <= 750.0], 0.0, 750.0]:  # the stations above, the top of the drill pipe and the string
         assert np.min(np.abs(above - x)) < 1e-9
     assert main(["scene", "demos/scenes/well_build_hold.toml", "--set", "model.axial_torsional_element_length=10"]) == 2
-    coarse = scene.with_changes(beam={"elements": 60})
-    np.testing.assert_array_equal(
-        BeamDiscretization.from_scene(coarse).vertex_x,
-        BeamDiscretization.from_scene(coarse.with_changes(model={"axial_torsional_element_length": -1.0})).vertex_x)
+    for kept in (scene.with_changes(beam={"elements": 60}), scene.with_changes(model={"lateral_length": 0.0})):
+        np.testing.assert_array_equal(
+            BeamDiscretization.from_scene(kept).vertex_x,
+            BeamDiscretization.from_scene(kept.with_changes(model={"axial_torsional_element_length": -1.0})).vertex_x)
 
 
 def test_coarse_axial_torsional_elements_keep_the_strings_modes_within_their_discretisation_error():
