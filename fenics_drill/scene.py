@@ -228,8 +228,8 @@ class Model:
     lateral_length: float = key(-1.0, "length above the bit whose lateral fields are solved; -1: all, 0: none [m]",
                                 lambda x: x == -1.0 or x >= 0, ">= 0 (or -1 for the whole string)")
     axial_torsional_element_length: float = key(
-        0.0, "element length above the lateral length (u, theta_x) [m]; 0: auto "
-        f"({AXIAL_TORSIONAL_ELEMENT_LENGTH:g} m above a BHA), -1: as below",
+        0.0, "element length above the lateral length (u, theta_x); 0: auto "
+        f"({AXIAL_TORSIONAL_ELEMENT_LENGTH:g} m above a BHA), -1: as below [m]",
         lambda x: x in (-1.0, 0.0) or x > 0, "> 0 (or 0 for auto, -1 for the lateral part's)")
 
 
