@@ -6,7 +6,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from fenics_drill.model.kernels.banded_saddle import BandedSaddle, SparseSum
+from fenics_drill.model.kernels.banded_saddle import BandedSaddle, SparseSum, Triplets
 from fenics_drill.model.drillstring import build_model
 from conftest import scene_with
 
@@ -52,7 +52,8 @@ def test_banded_saddle_matches_a_dense_solve_of_the_bordered_system(seed):
 def test_a_sum_kept_as_its_terms_solves_as_its_matrix_and_its_kept_layout_follows_no_stale_terms():
     """A tangent as the model forms it, SparseSum([(1, kept sum of three parts), (-1, fresh part)]): the solve equals
     the dense one of the summed matrix; a second tangent over the same kept sum with another fresh part (the kept
-    band copied, not laid out again) equals its own dense solve, and so does one under other held dofs."""
+    band copied, not laid out again) equals its own dense solve, and so does one under other held dofs; the fresh
+    part as a SciPy COO matrix or as :class:`Triplets` (how the point forces give theirs) alike."""
     n, width = 60, 3
     order = scrambled_band(n, width, 3)[2]
     dense_parts = []  # five banded matrices in that one numbering; the first diagonally dominant
@@ -64,9 +65,12 @@ def test_a_sum_kept_as_its_terms_solves_as_its_matrix_and_its_kept_layout_follow
         dense_parts.append(dense)
     kept = SparseSum([(1.0, dense_parts[0]), (2.5, dense_parts[1]), (-0.5, dense_parts[2])], (n, n))
     rng = np.random.default_rng(30)
-    for fresh in (dense_parts[3], dense_parts[4]):
+    for fresh, as_entries in ((dense_parts[3], False), (dense_parts[4], False), (dense_parts[4], True)):
+        entries = sp.coo_matrix(fresh)
+        if as_entries:
+            entries = Triplets(entries.data, entries.row, entries.col, entries.shape)
         for held in (rng.choice(n, size=2, replace=False), rng.choice(n, size=1, replace=False)):
-            tangent = SparseSum([(1.0, kept), (-1.0, sp.coo_matrix(fresh))], (n, n))
+            tangent = SparseSum([(1.0, kept), (-1.0, entries)], (n, n))
             matrix = dense_parts[0] + 2.5 * dense_parts[1] - 0.5 * dense_parts[2] - fresh
             # the same sums in another order: entries of size ~40 (the dominant diagonal) agree to a few ulps, and a
             # product's rows (7 such terms each) to ten
