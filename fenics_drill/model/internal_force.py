@@ -31,6 +31,7 @@ from fenics_drill.forms import energies
 from fenics_drill.model.kernels.banded_saddle import SparseSum
 from fenics_drill.model.kernels.cell_kernels import CellAssembly
 from fenics_drill.model.kernels.compiled import form as compiled_form
+from fenics_drill.model.kernels.compiled import kernel
 from fenics_drill.model.discretization import THETA_Y, THETA_Z, V, W, BeamDiscretization
 from fenics_drill.model.operators import LinearOperators
 from fenics_drill.model.kernels.packed_rows import FieldPackedRows
@@ -434,9 +435,16 @@ class FullSpacePacking:
 
     def packed(self, state: np.ndarray) -> np.ndarray:
         """The cells' packed coefficients (cells x per cell) at the stacked full-space ``state``."""
-        out = self.offset.copy()
-        out[self.rows] += state[self.index]
-        return out.reshape(self.cells, -1)
+        return _offset_plus_placed(self.offset, self.rows, self.index, state).reshape(self.cells, -1)
+
+
+@kernel
+def _offset_plus_placed(offset, rows, index, state):
+    """offset with state[index[k]] added at rows[k] (the rows are distinct: :func:`packed_placement`)."""
+    out = offset.copy()
+    for k in range(rows.size):
+        out[rows[k]] += state[index[k]]
+    return out
 
 
 class SampledCoefficients:

@@ -75,7 +75,7 @@ def kept_tangent_step(internal, forces, order, constraints, drive_loads, lu, mas
 
     ``newmark``: (gamma, beta); ``levels``: (force level, multiplier levels) of the accepted steps; ``settling``:
     (settle length, < 0 for none; SETTLED_SHARE); ``drifted``: whether a slow update would assemble df/dq afresh;
-    ``rates``: (TANGENT_REUSE_RATE, SLOW_CONTRACTION, SETTLED_CONTRACTION, SETTLED_FORCE_SHARE, ROUND_OFF, ARMIJO,
+    ``rates``: (the tangent reuse rate, SLOW_CONTRACTION, SETTLED_CONTRACTION, SETTLED_FORCE_SHARE, ROUND_OFF, ARMIJO,
     tolerance).  Returns (taken, q, qd, qdd, mu, iterations, the evaluation of :func:`residual_at` at q, force
     level, multiplier levels, whether the tangent may be carried on); not taken: the step is Python's."""
     reuse_rate, slow_contraction, settled_contraction, force_share, round_off, armijo, tolerance = rates

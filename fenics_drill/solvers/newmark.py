@@ -22,8 +22,13 @@ from fenics_drill.solvers.newton import ARMIJO, KeptTangent, saddle_newton
 
 
 #: A Newton iterate keeps the tangent of the previous one while the residual shrinks at least this much
-#: per update (the stiff bit and wall laws make it rarely so in their transients: then it is fresh).
+#: per update (the stiff bit and wall laws make it rarely so in their transients: then it is fresh) ...
 TANGENT_REUSE_RATE = 0.1
+#: ... and in the full space this much.  There a fresh tangent's banded factorisation costs about an evaluation,
+#: where a modal space's dense one costs several: a tangent that contracts by less than 30 times per update is
+#: worth its refresh.  Measured on the VBH well's 150 m BHA split over 10 s of stick-slip: 13 % less wall time
+#: than at 0.1, the same period, severity and rop to 0.5 % (docs/performance.md, "The BHA split").
+TANGENT_REUSE_RATE_FULL = 0.03
 #: A Newton update that shrinks the residual less than this (where a consistent tangent gives quadratic
 #: convergence) has the stiffness part df/dq of the internal tangent of earlier steps assembled afresh for the
 #: next one.  It is the part that drifts between the periodic refreshes: the spin turns the stiffness of a
@@ -114,6 +119,7 @@ class NewmarkNewton:
         self._multiplier_level = np.zeros(model.constraints.shape[0])  # the largest |mu_i| of the accepted steps
         self.settle_length = settle_length
         self.settled_share = SETTLED_SHARE_FULL if model.space.sparse else SETTLED_SHARE
+        self.reuse_rate = TANGENT_REUSE_RATE_FULL if model.space.sparse else TANGENT_REUSE_RATE
         self._motion_bound = column_bound(model.motion_rows)
         self._carried = KeptTangent()  # the last step's tangent, for the next step of the same size
         self._carried_dt = None
@@ -264,7 +270,7 @@ class NewmarkNewton:
                     self._carried.matrix = None
                 return taken
         result = saddle_newton(trial, self.model.space, self.model.constraints, target,
-                               q, mu, ev, check, self.max_iterations, reuse_rate=TANGENT_REUSE_RATE,
+                               q, mu, ev, check, self.max_iterations, reuse_rate=self.reuse_rate,
                                kink_step=lambda ev, dq: self.model.kink_step(ev, dq, c_v), settled=settled,
                                kept=self._carried)
         if result is None or result[1] > CARRY_WITHIN:
@@ -293,7 +299,7 @@ class NewmarkNewton:
         model = self.model
         lu = model.space.factorised(self._carried.matrix, model.constraints)
         settle = -1.0 if self.settle_length is None else self.settle_length
-        rates = (TANGENT_REUSE_RATE, SLOW_CONTRACTION, SETTLED_CONTRACTION, SETTLED_FORCE_SHARE, ROUND_OFF, ARMIJO,
+        rates = (self.reuse_rate, SLOW_CONTRACTION, SETTLED_CONTRACTION, SETTLED_FORCE_SHARE, ROUND_OFF, ARMIJO,
                  self.tolerance)
         taken, q, qd, qdd, mu, iterations, ev, force_level, multipliers, kept = kept_tangent_step(
             self._compiled.internal, forces, self._compiled.order, model.constraints, self._compiled.drive_loads,

@@ -256,7 +256,8 @@ def test_the_wall_tangent_of_a_modal_space_is_its_double_precision_product_to_si
         forces = wall.evaluate(q, qd, with_tangent=True)
         c_u, c_v = 1.0, 1e3
         tangent = wall.fresh().tangent(forces, c_u, c_v)  # formed whole (no kept tangent to update)
-        flat, positions, rates, vertices, _ = forces.tangent_data
+        rows_of, positions, rates, vertices, _ = forces.tangent_data
+        flat = rows_of.flat
         active = np.flatnonzero(forces.delta > 0)
         blocks = _contact_blocks(active, positions, rates, *wall._law(vertices), c_u, c_v)
         rows = flat.reshape(-1, 4, model.size)[active]  # (vertex, field, column)
@@ -299,7 +300,7 @@ def test_the_updated_wall_tangent_is_the_exact_one_within_its_block_tolerance():
         c_u, c_v = 1.0, (1e3 if state < 15 else 2e3)
         forces = wall.evaluate(q, qd, with_tangent=True)
         tangent = wall.tangent(forces, c_u, c_v)
-        flat, lateral, rates, vertices, _ = forces.tangent_data
+        _, lateral, rates, vertices, _ = forces.tangent_data
         active = np.flatnonzero(forces.delta > 0)
         blocks = np.zeros_like(largest)
         blocks[forces.vertices[active]] = _contact_blocks(active, lateral, rates, *wall._law(vertices), c_u, c_v)

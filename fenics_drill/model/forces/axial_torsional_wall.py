@@ -24,7 +24,7 @@ import numpy as np
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
 from fenics_drill.model.kernels.banded_saddle import Triplets
-from fenics_drill.model.forces.wall.coulomb import coulomb_friction
+from fenics_drill.model.forces.wall.coulomb import _return_maps
 from fenics_drill.model.soft_string import operations, soft_string, string_mesh
 from fenics_drill.model.well import string_in_well
 
@@ -72,6 +72,9 @@ class AxialTorsionalWall:
                                                      disc.vertex_dofs(THETA_X)[self.vertices]]))
         self.normal, self.arm = normal[self.vertices], arm[self.vertices]
         self.friction, self.stick_stiffness = friction, stick_stiffness
+        # the return mapping's arguments as its compiled kernel takes them
+        self._normal_force = np.ascontiguousarray(-self.normal, dtype=float)
+        self._friction, self._stick_stiffness = float(friction), float(stick_stiffness)
         self.space = space
         self._history = None  # (u, theta_x) and (F_a, F_t) at the last accepted state; None outside a run
 
@@ -121,8 +124,8 @@ class AxialTorsionalWall:
         axial_slip, tangential_slip = u - u0, self.arm * (theta - theta0)
         trial_a = held_a - self.stick_stiffness * axial_slip
         trial_t = held_t - self.stick_stiffness * tangential_slip
-        f_a, f_t = coulomb_friction(-self.normal, held_a, held_t, axial_slip, tangential_slip, self.friction,
-                                    self.stick_stiffness)
+        f_a, f_t = _return_maps(self._normal_force, held_a, held_t, axial_slip, tangential_slip, self._friction,
+                                self._stick_stiffness)
         generalised = self.rows.spread(np.concatenate([f_a, self.arm * f_t]))
         return AxialTorsionalWallForces(generalised, 0.0, {self.name: generalised}, f_a, f_t,
                                         np.hypot(trial_a, trial_t))

@@ -152,6 +152,30 @@ class VertexSet:
         """``flat``'s transpose (the full space's, sparse), formed once: P^T f of the vertices' loads f."""
         return self.flat.T.tocsr()
 
+    @functools.cached_property
+    def selection(self) -> tuple[np.ndarray, np.ndarray]:
+        """The full space's ``flat`` as a selection (:func:`_selection`): each row's dof (-1: none) and value."""
+        return _selection(self.flat)
+
+    @functools.cached_property
+    def _selected(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The rows of :attr:`selection` that select a dof, their dofs and their values."""
+        columns, values = self.selection
+        rows = np.flatnonzero(columns >= 0)
+        return rows, columns[rows], values[rows]
+
+    def gather(self, x: np.ndarray) -> np.ndarray:
+        """``flat @ x`` in the full space, as a gather (each row selects one dof or none)."""
+        rows, columns, values = self._selected
+        out = np.zeros(self.flat.shape[0])
+        out[rows] = values * x[columns]
+        return out
+
+    def scatter(self, loads: np.ndarray) -> np.ndarray:
+        """``flat.T @ loads`` in the full space, as a scatter of the loads' selected entries."""
+        rows, columns, values = self._selected
+        return np.bincount(columns, values * loads[rows], minlength=self.flat.shape[1])
+
 
 class WallContact:
     """Impact and friction forces of the borehole wall on the vertices of the mesh."""
@@ -246,30 +270,33 @@ class WallContact:
     def begin(self, t: float, q: np.ndarray) -> None:
         """Start the Coulomb force's memory at the initial state: anchored at q, no force yet."""
         if self.coulomb:
-            self._history = ((self.flat @ q).reshape(-1, len(FIELDS)), np.zeros((len(self.x), 2)))
+            self._history = (self._at_vertices(q), np.zeros((len(self.x), 2)))
 
     def accept(self, t: float, q: np.ndarray, qd: np.ndarray) -> None:
         """Anchor the Coulomb force at an accepted state, holding the force each vertex feels there."""
         if not self.coulomb or self._history is None:
             return
-        positions = (self.flat @ q).reshape(-1, len(FIELDS))
-        rates = (self.flat @ qd).reshape(-1, len(FIELDS))
+        positions, rates = self._at_vertices(q), self._at_vertices(qd)
         _, nodal, _, _ = _vertex_loads(positions, rates, *self._law())
         self._history = (positions, np.column_stack([nodal[:, 0], nodal[:, 3] / self.arm]))
+
+    def _at_vertices(self, x: np.ndarray) -> np.ndarray:
+        """(u, v, w, theta_x) of every vertex (a row each) of the dofs' or reduced values x."""
+        values = self.every.gather(x) if sp.issparse(self.flat) else self.flat @ x
+        return values.reshape(-1, len(FIELDS))
 
     def kept_on_wall(self, q_from: np.ndarray, q: np.ndarray) -> np.ndarray:
         """q with each vertex that touched the wall at ``q_from`` moved radially to the indentation it had there
         (full space: its (v, w) rows select dofs): a Newmark predictor extrapolates along a straight line, off the
         round wall."""
-        lateral = self.every.lateral_rows
-        before = (lateral @ q_from).reshape(-1, 2)
-        now = (lateral @ q).reshape(-1, 2)
+        lateral = slice(1, 3)  # (v, w) among FIELDS
+        before = self._at_vertices(q_from)[:, lateral]
+        now = self._at_vertices(q)[:, lateral]
         r_before, r_now = np.hypot(*before.T), np.hypot(*now.T)
         touching = (r_before > self.gap) & (r_now > 0.0)
         scale = np.ones_like(r_now)
         scale[touching] = r_before[touching] / r_now[touching]
-        columns, _ = _selection(lateral)
-        columns = columns.reshape(-1, 2)
+        columns = self.every.selection[0].reshape(-1, len(FIELDS))[:, lateral]
         out = q.copy()
         for k in range(2):
             free = columns[:, k] >= 0
@@ -331,10 +358,10 @@ class WallContact:
         if self._share is not None:
             return self._shared_evaluation(vertex_set, q, qd, with_tangent)
         if sp.issparse(vertex_set.flat):  # the full space: the rows select dofs
-            positions = (vertex_set.flat @ q).reshape(-1, len(FIELDS))
-            rates = (vertex_set.flat @ qd).reshape(-1, len(FIELDS))
+            positions = vertex_set.gather(q).reshape(-1, len(FIELDS))
+            rates = vertex_set.gather(qd).reshape(-1, len(FIELDS))
             delta, nodal, laws, potential = _vertex_loads(positions, rates, *self._law(vertex_set.vertices))
-            generalised = np.asarray(vertex_set.flat_transposed @ nodal.ravel())
+            generalised = vertex_set.scatter(nodal.ravel())
         else:
             delta, nodal, laws, potential, generalised, positions, rates = _modal_pass(
                 vertex_set.packed.kernel_data(), q.size, q, qd, *self._law(vertex_set.vertices))
@@ -350,8 +377,9 @@ class WallContact:
         if self._mine is None or self._mine[0] is not vertex_set:
             mine = np.flatnonzero(owned[vertex_set.vertices])
             rows = (len(FIELDS) * mine[:, None] + np.arange(len(FIELDS))).ravel()
-            self._mine = (vertex_set, mine, vertex_set.flat[rows])
-        _, mine, flat = self._mine
+            self._mine = (vertex_set, mine, VertexSet(vertex_set.vertices[mine], None, vertex_set.flat[rows], None))
+        _, mine, mine_set = self._mine
+        flat = mine_set.flat
         positions = (flat @ q).reshape(-1, len(FIELDS))
         rates = (flat @ qd).reshape(-1, len(FIELDS))
         delta_mine, nodal_mine, laws_mine, potential = _vertex_loads(positions, rates,
@@ -371,7 +399,7 @@ class WallContact:
         out = self.forces_of(vertex_set, (delta, nodal.reshape(m, len(FIELDS)), laws.reshape(m, len(FIELDS), names),
                                           float(energy[0]), generalised, None, None), False)
         if with_tangent:
-            out.tangent_data = (flat, positions, rates, vertex_set.vertices[mine], delta_mine)
+            out.tangent_data = (mine_set, positions, rates, vertex_set.vertices[mine], delta_mine)
         return out
 
     def forces_of(self, vertex_set: VertexSet, passed: tuple, with_tangent: bool) -> WallForces:
@@ -382,7 +410,7 @@ class WallContact:
         out = WallForces(generalised, potential, by_law, len(self.x), vertex_set.vertices, delta, nodal,
                          tangential_arm=self.arm if self.coulomb else None)
         if with_tangent:  # what the tangent needs, differentiated only if Newton asks for it
-            out.tangent_data = (vertex_set.flat, positions, rates, vertex_set.vertices, delta)
+            out.tangent_data = (vertex_set, positions, rates, vertex_set.vertices, delta)
         return out
 
     def evaluated_vertices(self) -> VertexSet:
@@ -410,13 +438,14 @@ class WallContact:
         Newton, and the residual, in double precision, decides when it has converged."""
         if forces.tangent_data is None:
             return None
-        flat, positions, rates, vertices, delta = forces.tangent_data
+        rows_of, positions, rates, vertices, delta = forces.tangent_data
+        flat = rows_of.flat
         active = np.flatnonzero(delta > 0)
         if active.size == 0:
             return None
         blocks = _contact_blocks(active, positions, rates, *self._law(vertices), c_u, c_v)
         if sp.issparse(flat):  # the full space: each row of [Phi] selects one free dof (or none, at a support)
-            columns, values = _selection(flat)
+            columns, values = rows_of.selection
             at = len(FIELDS) * active[:, None] + np.arange(len(FIELDS))
             dofs, scale = columns[at], values[at]
             rows, columns = np.broadcast_arrays(dofs[:, :, None], dofs[:, None, :])

@@ -87,12 +87,13 @@ class SelectedPointRows:
         self.free = self.positions >= 0
 
     def values(self, x: np.ndarray) -> np.ndarray:
-        return np.where(self.free, np.asarray(x)[np.maximum(self.positions, 0)], 0.0)
+        out = np.zeros(self.positions.size)
+        out[self._kept] = np.asarray(x)[self._kept_positions]
+        return out
 
     def spread(self, point_values: np.ndarray) -> np.ndarray:
-        out = np.zeros(self.size)
-        np.add.at(out, self.positions[self.free], np.asarray(point_values, dtype=float)[self.free])
-        return out
+        return np.bincount(self._kept_positions, np.asarray(point_values, dtype=float)[self._kept],
+                           minlength=self.size)
 
     def unit_loads(self) -> tuple[np.ndarray, ...]:
         return tuple(self.spread(unit) for unit in np.eye(self.positions.size))
@@ -106,6 +107,10 @@ class SelectedPointRows:
     @functools.cached_property
     def _kept(self) -> np.ndarray:
         return np.flatnonzero(self.free)
+
+    @functools.cached_property
+    def _kept_positions(self) -> np.ndarray:
+        return self.positions[self._kept]
 
     @functools.cached_property
     def _block_entries(self) -> tuple[np.ndarray, np.ndarray]:
