@@ -170,7 +170,7 @@ class AssembledInternalForce:
     cells, or the sample's), a third faster than DOLFINx's assembly and projection over all cells.  Its tangents
     over all cells come from the same kernels over every cell, with the coefficients packed by DOLFINx
     (:class:`TangentEntries`); the full order's force and tangents from them too, with the coefficients read off
-    its state (:class:`FullSpacePacking`), and its energies from DOLFINx.
+    its state (:class:`FullSpacePacking`), and its energies the same way.
     """
 
     def __init__(self, disc: BeamDiscretization, space, operators: LinearOperators,
@@ -317,24 +317,30 @@ class AssembledInternalForce:
 
     def _kinetic_energies(self, qs, qds) -> np.ndarray:
         if self._kernel_cells is None:
-            energies = []
-            for q, qd in zip(qs, qds):
-                self._set(self.U, q)
-                self._set(self.V, qd)
-                energies.append(fem.assemble_scalar(self._kinetic))
-            return np.array(energies)
+            return self._full_space_functional(self._kinetic_full, np.hstack((qs, qds)))
         energies = self._kinetic_cells.assemble_rows(np.hstack((qs, qds)))
         return energies if self.sample is None else energies + quadratic_forms(self.linear[2], qds)
 
     def _strain_energies(self, qs) -> np.ndarray:
         if self._kernel_cells is None:
-            energies = []
-            for q in qs:
-                self._set(self.U, q)
-                energies.append(fem.assemble_scalar(self._strain))
-            return np.array(energies)
+            return self._full_space_functional(self._strain_full, qs)
         energies = self._strain_cells.assemble_rows(qs)
         return energies if self.sample is None else energies + quadratic_forms(self.linear[0], qs)
+
+    @functools.cached_property
+    def _kinetic_full(self) -> tuple["FullSpacePacking", CellAssembly]:
+        return FullSpacePacking(self._kinetic, (self.U, self.V), self.space), CellAssembly(self._kinetic)
+
+    @functools.cached_property
+    def _strain_full(self) -> tuple["FullSpacePacking", CellAssembly]:
+        return FullSpacePacking(self._strain, (self.U,), self.space), CellAssembly(self._strain)
+
+    @staticmethod
+    def _full_space_functional(assembly, states: np.ndarray) -> np.ndarray:
+        """An energy of the full space at each row of ``states`` (its functions' values stacked), from its cells'
+        kernels with the coefficients read off the state."""
+        packing, cells = assembly
+        return np.array([cells(packing.packed(state)) for state in states])
 
     def damping_force(self, qd) -> np.ndarray:
         return self._damping @ qd

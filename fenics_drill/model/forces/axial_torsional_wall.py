@@ -24,6 +24,7 @@ import numpy as np
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
 from fenics_drill.model.kernels.banded_saddle import Triplets
+from fenics_drill.model.kernels.compiled import kernel
 from fenics_drill.model.forces.wall.coulomb import _return_maps
 from fenics_drill.model.soft_string import operations, soft_string, string_mesh
 from fenics_drill.model.well import string_in_well
@@ -136,31 +137,11 @@ class AxialTorsionalWall:
         n = self.vertices.size
         if self._history is None or n == 0:
             return None
-        cap = self.friction * np.abs(self.normal)
-        sliding = forces.trial > cap
-        shrink = np.where(sliding, cap / np.maximum(forces.trial, 1e-300), 1.0)
-        e_a = np.where(sliding, forces.axial / np.maximum(cap, 1e-300), 0.0)
-        e_t = np.where(sliding, forces.tangential / np.maximum(cap, 1e-300), 0.0)
-        k = -c_u * self.stick_stiffness * shrink
-        r = self.arm
-        # d(F_a, F_t) / d(g_a, g_t) = k (I - s e e^T), g = (u, r theta): the rows of theta_x carry r, its columns r
-        s = sliding.astype(float)
-        aa, at, tt = k * (1 - s * e_a * e_a), -k * s * e_a * e_t, k * (1 - s * e_t * e_t)
-        return self._block_diagonal(aa, at * r, r * r * tt)
-
-    def _block_diagonal(self, uu: np.ndarray, ut: np.ndarray, tt: np.ndarray):
-        """P^T B P for the 2 x 2 blocks [[uu, ut], [ut, tt]] of each vertex's (u, theta_x): scattered into the
-        sparse tangent of the full space, or as the dense product with the rows of a modal basis."""
-        n = self.vertices.size
+        uu, ut, tt = _vertex_blocks(forces.trial, forces.axial, forces.tangential, self.normal, self._friction,
+                                    self._stick_stiffness, float(c_u), self.arm)
         if self.space.sparse:
             where = self.rows.positions
-            pu, pt = where[:n], where[n:]
-            rows = np.concatenate([pu, pu, pt, pt])
-            columns = np.concatenate([pu, pt, pu, pt])
-            data = np.concatenate([uu, ut, ut, tt])
-            kept = (rows >= 0) & (columns >= 0)
-            size = self.space.size
-            return Triplets(data[kept], rows[kept], columns[kept], (size, size))
+            return Triplets(*_diagonal_block_entries(where[:n], where[n:], uu, ut, tt), (self.space.size,) * 2)
         rows = self.rows.dense()
         ru, rt = rows[:n], rows[n:]
         return (ru.T @ (uu[:, None] * ru) + ru.T @ (ut[:, None] * rt) + rt.T @ (ut[:, None] * ru)
@@ -170,3 +151,42 @@ class AxialTorsionalWall:
         cap = self.friction * np.abs(self.normal)
         stuck = np.count_nonzero((forces.trial <= cap) & (cap > 0)) if forces.trial is not None else 0
         return {"vertices_stuck_on_the_wall": int(stuck)}
+
+
+@kernel
+def _vertex_blocks(trial, axial, tangential, normal, friction, stick_stiffness, c_u, arm):
+    """Each vertex's 2 x 2 block [[uu, ut], [ut, tt]] of c_u d(F_a, R F_t)/d(u, theta_x)
+    (:meth:`AxialTorsionalWall.tangent`): d(F_a, F_t)/d(g_a, g_t) = k (I - s e e^T) with k = -c_u k_t |F|/|F*| and
+    s = 1 sliding (k = -c_u k_t, s = 0 stuck), g = (u, R theta_x): the rows of theta_x carry R, its columns R."""
+    n = trial.size
+    uu, ut, tt = np.empty(n), np.empty(n), np.empty(n)
+    for i in range(n):
+        cap = friction * abs(normal[i])
+        sliding = trial[i] > cap
+        shrink = cap / max(trial[i], 1e-300) if sliding else 1.0
+        e_a = axial[i] / max(cap, 1e-300) if sliding else 0.0
+        e_t = tangential[i] / max(cap, 1e-300) if sliding else 0.0
+        s = 1.0 if sliding else 0.0
+        k = -c_u * stick_stiffness * shrink
+        uu[i] = k * (1 - s * e_a * e_a)
+        ut[i] = -k * s * e_a * e_t * arm[i]
+        tt[i] = arm[i] * arm[i] * (k * (1 - s * e_t * e_t))
+    return uu, ut, tt
+
+
+@kernel
+def _diagonal_block_entries(at_u, at_theta, uu, ut, tt):
+    """The entries (value, row, column) of the 2 x 2 blocks at each vertex's dofs (u, theta_x) (-1: held, left out):
+    the uu entries, then ut, tu and tt."""
+    n = at_u.size
+    data, rows, cols = np.empty(4 * n), np.empty(4 * n, dtype=np.int64), np.empty(4 * n, dtype=np.int64)
+    m = 0
+    for block in range(4):
+        for i in range(n):
+            row = at_u[i] if block < 2 else at_theta[i]
+            column = at_u[i] if block % 2 == 0 else at_theta[i]
+            if row >= 0 and column >= 0:
+                data[m] = uu[i] if block == 0 else (tt[i] if block == 3 else ut[i])
+                rows[m], cols[m] = row, column
+                m += 1
+    return data[:m], rows[:m], cols[:m]

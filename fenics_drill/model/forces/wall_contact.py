@@ -39,9 +39,8 @@ import scipy.sparse as sp
 from fenics_drill.model.discretization import BeamDiscretization
 from fenics_drill.model.forces.protocol import ForceEvaluation
 from fenics_drill.model.forces.wall.vertex_passes import (FIELDS, _contact_blocks, _modal_pass, _moved_blocks,
-                                                          _projected_laws,
-                                                          _scattered_square, _selection, _vertex_loads,
-                                                          _weighted_rows)
+                                                          _projected_laws, _scattered_square, _selected_block_entries,
+                                                          _selection, _vertex_loads, _weighted_rows)
 from fenics_drill.model.kernels.banded_saddle import Triplets
 from fenics_drill.model.kernels.packed_rows import FieldPackedRows
 from fenics_drill.scene import LAW_SIGN
@@ -445,13 +444,7 @@ class WallContact:
             return None
         blocks = _contact_blocks(active, positions, rates, *self._law(vertices), c_u, c_v)
         if sp.issparse(flat):  # the full space: each row of [Phi] selects one free dof (or none, at a support)
-            columns, values = rows_of.selection
-            at = len(FIELDS) * active[:, None] + np.arange(len(FIELDS))
-            dofs, scale = columns[at], values[at]
-            rows, columns = np.broadcast_arrays(dofs[:, :, None], dofs[:, None, :])
-            data = scale[:, :, None] * blocks * scale[:, None, :]
-            kept = (rows >= 0) & (columns >= 0) & (data != 0.0)
-            return Triplets(data[kept], rows[kept], columns[kept], (flat.shape[1],) * 2)
+            return Triplets(*_selected_block_entries(active, *rows_of.selection, blocks), (flat.shape[1],) * 2)
         return self._updated_tangent(vertices[active], blocks)
 
     #: A vertex's block enters the modal tangent afresh when it changed by more than this share of the largest

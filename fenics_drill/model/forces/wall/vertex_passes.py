@@ -254,6 +254,27 @@ def _moved_blocks(vertices, blocks, kept, tolerance):
     return changed, increments, updated
 
 
+@kernel
+def _selected_block_entries(active, columns, values, blocks):
+    """The full space's tangent entries (value, row, column) of the vertices ``active``' 4 x 4 blocks, whose rows
+    select the dofs ``columns`` with ``values`` (:func:`_selection`, -1: none): s_a A_ab s_b at (dof_a, dof_b), row by
+    row, leaving out unselected dofs and zero values."""
+    fields = blocks.shape[1]
+    count = active.size * fields * fields
+    data, rows, cols = np.empty(count), np.empty(count, dtype=np.int64), np.empty(count, dtype=np.int64)
+    n = 0
+    for k in range(active.size):
+        for a in range(fields):
+            row, scale_a = columns[fields * active[k] + a], values[fields * active[k] + a]
+            for b in range(fields):
+                column, scale_b = columns[fields * active[k] + b], values[fields * active[k] + b]
+                value = scale_a * blocks[k, a, b] * scale_b
+                if row >= 0 and column >= 0 and value != 0.0:
+                    data[n], rows[n], cols[n] = value, row, column
+                    n += 1
+    return data[:n], rows[:n], cols[:n]
+
+
 def _selection(rows: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
     """(column, value) of each row of a full space's [Phi] rows, which hold one entry or none (a dof held by
     a support: column -1, value 0)."""
