@@ -214,6 +214,26 @@ def band_order_positions(order: np.ndarray) -> np.ndarray:
     return position
 
 
+#: The frames of the saddle systems factorised lately (:func:`_frame`), by the identities of their constraints and
+#: numbering, which they hold (so that those identities are not reused while kept).
+_FRAMES: dict = {}
+
+
+def _frame(constraints, order: np.ndarray, n: int, width: int | None):
+    """(held dofs, their coefficients, each dof's band index, the band layout or None if ``width`` is None) of a saddle
+    system with these constraints and numbering: found once for the many tangents a run factorises with them."""
+    key = (id(constraints), id(order), n, width)
+    kept = _FRAMES.get(key)
+    if kept is None or kept[0] is not constraints or kept[1] is not order:
+        held, coefficients = held_dofs(constraints)
+        position = band_order_positions(order)
+        layout = None if width is None else BandLayout(position, position[held], n, width, width, id(order))
+        if len(_FRAMES) >= 8:
+            _FRAMES.clear()
+        kept = _FRAMES[key] = (constraints, order, held, coefficients, position, layout)
+    return kept[2:]
+
+
 class BandedSaddle:
     """The factorised saddle matrix [[J, B^T], [B, 0]] of (76), J sparse, its dofs renumbered by ``order``."""
 
@@ -221,17 +241,15 @@ class BandedSaddle:
         """``tangent``: a sparse matrix or a :class:`SparseSum`; ``width``: the bandwidth the renumbered J has by
         construction (found from its entries if None); an entry outside it is an error."""
         n = tangent.shape[0]
-        self.held, self.coefficients = held_dofs(constraints)
+        self.held, self.coefficients, position, layout = _frame(constraints, order, n, width)
         self.order = order
-        position = band_order_positions(order)
         self.held_band = position[self.held]
-        if width is None:
+        if layout is None:
             coo = tangent.tocoo() if isinstance(tangent, SparseSum) else sp.coo_matrix(tangent)
             probe = BandLayout(position, self.held_band, n, 0, 0, id(order))
-            self.kl, self.ku = _band_widths(coo.row, coo.col, position, probe.taken_slot)
-        else:
-            self.kl = self.ku = width
-        layout = BandLayout(position, self.held_band, n, self.kl, self.ku, id(order))
+            kl, ku = _band_widths(coo.row, coo.col, position, probe.taken_slot)
+            layout = BandLayout(position, self.held_band, n, kl, ku, id(order))
+        self.kl, self.ku = layout.kl, layout.ku
         band, self.held_columns, self.held_rows = layout.laid_out(tangent)
         self.lu, self.pivots, info = lapack.dgbtrf(band, self.kl, self.ku, overwrite_ab=1)
         if info != 0:
