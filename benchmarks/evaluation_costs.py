@@ -1,8 +1,9 @@
 """What one Newton iterate of the scene's model costs, part by part, at a state of a drilling run.
 
-    python benchmarks/evaluation_costs.py [T_STATE] [SECTION.KEY=VALUE ...]
+    python benchmarks/evaluation_costs.py [--scene FILE] [T_STATE] [SECTION.KEY=VALUE ...]
 
-Prepares the paper scene (with the settings given: ``beam.length=3000 beam.elements=6000`` for 3 km), runs it for
+Prepares the paper scene, or the scene FILE (with the settings given: ``beam.length=3000 beam.elements=6000`` for
+3 km of the paper's string), runs it for
 T_STATE seconds (default 0.5), and times at the last state each part of a Newton iterate (the model's residual, its
 tangent, the internal force and its tangent parts, every point force with and without its tangent, the saddle
 system (76) factorised and solved, a solve with the factorisation kept, the von Mises maximum of an accepted step),
@@ -37,9 +38,12 @@ def per_call(function, calls: int, rounds: int = 5) -> float:
 
 
 def main() -> None:
-    t_state = float(sys.argv[1]) if len(sys.argv) > 1 and "=" not in sys.argv[1] else 0.5
-    overrides = [a for a in sys.argv[1:] if "=" in a]
-    scene = load_scene("demos/scenes/paper.toml", [f"time.t_end={t_state}", "output.field_interval=0", *overrides])
+    arguments, path = sys.argv[1:], "demos/scenes/paper.toml"
+    if arguments[:1] == ["--scene"]:
+        path, arguments = arguments[1], arguments[2:]
+    t_state = float(arguments[0]) if arguments and "=" not in arguments[0] else 0.5
+    overrides = [a for a in arguments if "=" in a]
+    scene = load_scene(path, [f"time.t_end={t_state}", "output.field_interval=0", *overrides])
     prepared = prepare(scene)
     model = prepared.model
     simulation = Simulation(model, scene)

@@ -26,8 +26,9 @@ from fenics_drill.solvers.newton import ARMIJO, KeptTangent, saddle_newton
 TANGENT_REUSE_RATE = 0.1
 #: ... and in the full space this much.  There a fresh tangent's banded factorisation costs about an evaluation,
 #: where a modal space's dense one costs several: a tangent that contracts by less than 30 times per update is
-#: worth its refresh.  Measured on the VBH well's 150 m BHA split over 10 s of stick-slip: 13 % less wall time
-#: than at 0.1, the same period, severity and rop to 0.5 % (docs/performance.md, "The BHA split").
+#: worth its refresh.  Measured on the VBH well's 150 m BHA split over its first 3 s: 6 % fewer Newton iterations
+#: than at 0.1 for as many factorisations; over 10 s of stick-slip its severity, rop and surface torque within
+#: 1.3 %, 0.24 % and 0.1 % of those at 0.1 (docs/performance.md, "The BHA split").
 TANGENT_REUSE_RATE_FULL = 0.03
 #: A Newton update that shrinks the residual less than this (where a consistent tangent gives quadratic
 #: convergence) has the stiffness part df/dq of the internal tangent of earlier steps assembled afresh for the
