@@ -18,6 +18,7 @@ from fenics_drill.model.internal_force import AssembledInternalForce, LateralZon
 from fenics_drill.model.operators import assemble_linear
 from fenics_drill.model.reduction.spaces import FullSpace
 from fenics_drill.model.reduction.modes import solve_modes
+from fenics_drill.studies.prepare import prepare
 
 
 def test_the_lateral_fields_are_held_above_the_lateral_length():
@@ -108,6 +109,46 @@ def test_the_wall_friction_of_an_axial_torsional_pipe_turning_on_the_wall_is_mu_
                 + p.damping * p.density * polar * scene.drive.rotation_speed * p.length)
     assert np.trapezoid(torque[late], t[late]) / (t[late][-1] - t[late][0]) == pytest.approx(expected, rel=1e-3)
     assert np.all(run.series["section_v"].values == 0.0)
+
+
+@pytest.mark.parametrize("space", ["full", "modal"])
+def test_the_axial_torsional_walls_tangent_is_the_derivative_of_its_force(space):
+    """The 900 m build-and-hold well's axial-torsional wall (its 60 m split, in the full space; the axial-torsional
+    string, modal) anchored at a state, then moved by slips of 1e-9 to 1e-4 m per vertex, so that some contacts stay
+    stuck (F = F* = -k_t g) and others slide on the cone (F = mu N F*/|F*|).  Its tangent c_u dF/dq, in the full
+    space (entries laid into the band) and in the modal one (dense), against central differences of its generalised
+    force: within 1e-6 of the largest entry (measured 4e-9 and 7e-8; h = 1e-12 m moves a trial force by 1e-4 N, far
+    from the cone at the contacts checked, and its round-off in a force of 1e2-1e3 N is 1e-13 / 1e-12 of it)."""
+    lateral_length = 60.0 if space == "full" else 0.0  # a split runs in the full space; the string at 0 is modal
+    scene = fd.load_scene("demos/scenes/well_build_hold.toml", ["beam.elements=100",
+                                                                 f"model.lateral_length={lateral_length}"])
+    model = prepare(scene, dynamics=False).model
+    assert model.space.sparse == (space == "full")
+    wall = model.force("axial_torsional_wall").fresh()
+    rng = np.random.default_rng(11)
+    q0 = 1e-3 * rng.standard_normal(model.size)
+    wall.begin(0.0, q0)
+    n = wall.vertices.size
+    slips = rng.standard_normal(2 * n) * 10.0 ** rng.uniform(-9, -4, 2 * n)
+    rows = wall.rows.dense()  # a modal space reaches the slips it can: both branches still occur (asserted below)
+    q = q0 + (wall.rows.spread(slips) if space == "full" else np.linalg.lstsq(rows, slips, rcond=None)[0])
+    forces = wall.evaluate(q, np.zeros_like(q))
+    cap = wall.friction * np.abs(wall.normal)
+    sliding = forces.trial > cap
+    assert 0 < np.count_nonzero(sliding) < n  # both branches are checked
+    c_u = 1.7
+    tangent = wall.tangent(forces, c_u, 0.0)
+    tangent = tangent.toarray() if hasattr(tangent, "toarray") else tangent
+    h = 1e-12
+    numeric = np.empty((model.size, model.size))
+    for j in range(model.size):
+        up, down = q.copy(), q.copy()
+        up[j] += h
+        down[j] -= h
+        change = wall.evaluate(up, 0 * up).generalised - wall.evaluate(down, 0 * down).generalised
+        numeric[:, j] = c_u * change / (2 * h)
+    assert np.abs(numeric).max() > 0
+    assert np.abs(tangent - numeric).max() <= 1e-6 * np.abs(numeric).max()
 
 
 @pytest.mark.parametrize("held", ["free-free", "drive-held", "bit stuck"])
