@@ -34,8 +34,9 @@ def main() -> None:
         wall, cpu = time.perf_counter(), time.process_time()
         s = run_scene(scene, out, progress=False, overwrite=True)
         wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-    print(f"wall {wall:.1f} s, cpu {cpu:.1f} s, steps {s['steps']} ({s.get('compiled_steps', 0)} compiled), "
-          f"Newton iterations {s['newton_iterations']}, "
+    print(f"wall {wall:.1f} s, cpu {cpu:.1f} s, steps {s['steps']} ({s.get('compiled_steps', 0)} compiled, "
+          f"{s.get('rejected_steps', 0)} rejected), Newton iterations {s['newton_iterations']}, "
+          f"factorisations {s.get('factorisations', 0)}, "
           f"rop {s['rop'] * 3600:.4f} m/h, efficiency {s['efficiency']:.5f}, "
           f"max von Mises {s.get('max_von_mises', {'value': float('nan')})['value'] / 1e6:.3f} MPa")
 
