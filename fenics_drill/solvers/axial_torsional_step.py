@@ -4,6 +4,9 @@ The string is :class:`~fenics_drill.model.axial_torsional_string.AxialTorsionalS
 step solves M a + C v + K q = F_G + F_wall(q) + F_bit(q, v) + F_drive(q, v) at t + dt by Newton, with Newmark's
 (gamma, beta) = (1/2 + alpha, (1 + alpha)^2 / 4) (alpha = ``time.newmark_alpha``); the tangent K + c_v C + c_a M
 less the laws' derivatives is factorised in its band (LU without pivoting: c_a M dominates it) at every iterate.
+An update that does not reduce the residual is cut first to just past the first kink of the bit's law along it
+(the FE Newton's line search, :func:`~fenics_drill.solvers.newton.backtrack`), then by halves: a full update that
+jumps the wear flats' contact ramp (v_c wide) otherwise cycles between its branches until the step is halved.
 
 * **Wall**: at each vertex the Coulomb force at the contact point by return mapping
   (:func:`~fenics_drill.model.forces.wall.coulomb._return_map`, the FE wall's law), its slip (du, R d theta_x)
@@ -28,7 +31,8 @@ import numpy as np
 from numba import njit
 
 from fenics_drill.model.forces.bit_rock import LAW as PAPER_LAW
-from fenics_drill.model.forces.cutting_bit import cutting_law, surface_at
+from fenics_drill.model.forces.bit_rock import fraction_past_kink
+from fenics_drill.model.forces.cutting_bit import cutting_law, cutting_law_kink, surface_at
 from fenics_drill.model.forces.wall.coulomb import _return_map
 from fenics_drill.model.kernels.compiled import kernel
 
@@ -42,17 +46,29 @@ CONVERGED, NOT_CONVERGED = 0, 1
 
 
 @njit(cache=True)
-def inertia_damping_stiffness(mass, damping, stiffness, w, acc, vel, x):
-    """M acc + C vel + K x in one pass over the bands."""
+def band_product(band, w, x):
+    """band x, ``band`` holding row i's entries of columns i - w .. i + w."""
     n = x.size
-    out = np.zeros(n)
+    out = np.empty(n)
     for i in range(n):
-        low, high = max(0, i - w), min(n, i + w + 1)
-        s = 0.0
-        for j in range(low, high):
-            k = j - i + w
-            s += mass[i, k] * acc[j] + damping[i, k] * vel[j] + stiffness[i, k] * x[j]
+        if w <= i < n - w:  # a whole row: a loop of fixed length
+            s = 0.0
+            for k in range(2 * w + 1):
+                s += band[i, k] * x[i - w + k]
+        else:
+            s = 0.0
+            for j in range(max(0, i - w), min(n, i + w + 1)):
+                s += band[i, j - i + w] * x[j]
         out[i] = s
+    return out
+
+
+@njit(cache=True)
+def _largest(values):
+    """max |values|."""
+    out = 0.0
+    for value in values:
+        out = max(out, abs(value))
     return out
 
 
@@ -117,24 +133,27 @@ def _previous_pass(surface, count, pruned, feed, passage, angle):
 
 
 @njit(cache=True)
-def _residual(mass, damping, stiffness, base, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind,
-              bit_law, drive, gamma, c_a, c_v, h, q, q_pred, v_pred, x, anchor, held, trial_held, surface,
-              surface_state, tangent):
+def _residual(base, offset, w, top, bit, wall_dofs, normal, arm, wall_law, bit_kind, bit_law, drive, c_v, h, q,
+              q_pred, v_pred, x, anchor, held, trial_held, surface, surface_state, tangent):
     """The residual of the step to x (the drive's held rows zero), with its tangent (from ``base`` = K + c_v C + c_a M)
-    written into ``tangent`` and
-    the wall's forces into ``trial_held``; and what is recorded of it: (residual, bit force, bit torque, depth of
-    cut, stuck vertices, top force, top torque, z)."""
-    acc = (x - q_pred) * c_a
-    vel = v_pred + gamma * h * acc
-    residual = inertia_damping_stiffness(mass, damping, stiffness, w, acc, vel, x) - gravity
+    written into ``tangent`` and the wall's forces into ``trial_held``; and what is recorded of it: (residual, bit
+    force, bit torque, depth of cut, stuck vertices, top force, top torque, z), then the bit's state for
+    :func:`_kink`: (u_dot, omega, u - S, dS/dphi).
+
+    M a + C v + K x - F_G = base (x - x_pred) + ``offset`` with ``offset`` = K x_pred + C v_pred - F_G, for
+    a = c_a (x - x_pred) and v = v_pred + c_v (x - x_pred) (Newmark's (67)-(68)): one band product per iterate, of
+    the step's increment over its predictor."""
+    increment = x - q_pred
+    residual = band_product(base, w, increment) + offset
     tangent[:, :] = base
     trial_held[:, :] = held
     stuck = _wall(x, wall_dofs, normal, arm, wall_law[0], wall_law[1], anchor, trial_held, residual, tangent, w)
     tu, tt = top
     bu, bt = bit
-    bit_force = bit_torque = depth = 0.0
+    bit_velocity, bit_spin = v_pred[bu] + c_v * increment[bu], v_pred[bt] + c_v * increment[bt]
+    bit_force = bit_torque = depth = clearance = slope = 0.0
     if bit_kind == PAPER:
-        bit_force, bit_torque, d_force, d_torque_v, d_torque_w = PAPER_LAW(vel[bu], vel[bt], bit_law[0],
+        bit_force, bit_torque, d_force, d_torque_v, d_torque_w = PAPER_LAW(bit_velocity, bit_spin, bit_law[0],
                                                                            bit_law[1], bit_law[2], bit_law[3])
         tangent[bu, w] -= c_v * d_force
         tangent[bt, bu - bt + w] -= c_v * d_torque_v
@@ -142,7 +161,8 @@ def _residual(mass, damping, stiffness, base, w, gravity, top, bit, wall_dofs, n
     elif bit_kind == CUTTING:
         cut, slope = _previous_pass(surface, int(surface_state[0]), surface_state[1] > 0.5, surface_state[2],
                                     bit_law[9], x[bt])
-        law = cutting_law(x[bu], vel[bu], vel[bt], cut, slope, bit_law[0], bit_law[1], bit_law[2], bit_law[3],
+        clearance = x[bu] - cut
+        law = cutting_law(x[bu], bit_velocity, bit_spin, cut, slope, bit_law[0], bit_law[1], bit_law[2], bit_law[3],
                           bit_law[4], bit_law[5], bit_law[6], bit_law[7], bit_law[8])
         depth, bit_force, bit_torque = law[0], law[1], law[2]
         tangent[bu, w] -= law[3] + c_v * law[7]
@@ -166,24 +186,40 @@ def _residual(mass, damping, stiffness, base, w, gravity, top, bit, wall_dofs, n
     else:  # z = z_n + int (Omega - theta_dot) dt over the step, frozen at the motor's limit
         omega, k_p, k_i, t_max = drive[4], drive[5], drive[6], drive[7]
         z = drive[8] + omega * h - (x[tt] - q[tt])
-        top_torque = k_p * (omega - vel[tt]) + k_i * z
+        top_torque = k_p * (omega - v_pred[tt] - c_v * increment[tt]) + k_i * z
         if abs(top_torque) > t_max:
             top_torque, z = math.copysign(t_max, top_torque), drive[8]
         else:
             tangent[tt, w] += k_p * c_v + k_i
         residual[tt] -= top_torque
-    return residual, bit_force, bit_torque, depth, stuck, top_force, top_torque, z
+    return (residual, bit_force, bit_torque, depth, stuck, top_force, top_torque, z, bit_velocity, bit_spin, clearance,
+            slope)
 
 
 @njit(cache=True)
-def _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind, bit_law,
+def _kink(bit_kind, bit_law, evaluated, du, dphi, c_v):
+    """The fraction of a Newton update that moves the bit's (u, theta_x) by (du, dphi) just past the first kink of
+    the bit's law along it (:meth:`~fenics_drill.model.forces.cutting_bit.CuttingBit.kink_step`,
+    :meth:`~fenics_drill.model.forces.bit_rock.BitRock.kink_step`), from the iterate ``evaluated`` by
+    :func:`_residual`; infinity if it crosses none."""
+    bit_velocity, bit_spin, clearance, slope = evaluated[8], evaluated[9], evaluated[10], evaluated[11]
+    if bit_kind == PAPER:
+        return fraction_past_kink(bit_velocity, c_v * du)
+    if bit_kind == CUTTING:
+        return cutting_law_kink(bit_velocity, bit_spin, clearance, slope, du, dphi, c_v, bit_law[0], bit_law[5],
+                                bit_law[6], bit_law[7], bit_law[8])
+    return math.inf
+
+
+@njit(cache=True)
+def _attempt(base, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind, bit_law,
              drive, h, newmark, tolerance, max_iterations, q, v, a, t, anchor, held, trial_held, surface,
              surface_state, tangent):
-    """One Newmark step of ``h`` from (q, v, a) at t by Newton, an update halved while it does not reduce the
-    residual (at most :data:`BACKTRACKS` times).  Returns (converged, x, recorded values of :func:`_residual`,
+    """One Newmark step of ``h`` from (q, v, a) at t by Newton, an update cut while it does not reduce the
+    residual (at most :data:`BACKTRACKS` times: first to just past the bit law's first kink along it, then by
+    halves); ``base`` = K + c_v C + c_a M at ``h``.  Returns (converged, x, recorded values of :func:`_residual`,
     iterations)."""
     gamma, beta = newmark
-    c_a = 1.0 / (beta * h * h)
     c_v = gamma / (beta * h)
     q_pred = q + h * v + h * h * (0.5 - beta) * a
     v_pred = v + h * (1.0 - gamma) * a
@@ -192,26 +228,29 @@ def _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, 
         x[top[0]] = drive[1] * (t + h)
     if drive[3] > 0.5:
         x[top[1]] = drive[4] * (t + h)
-    scale = max(np.max(np.abs(gravity)) * q.size, abs(drive[2]), 1.0)
-    base = stiffness + c_v * damping + c_a * mass
-    ev = _residual(mass, damping, stiffness, base, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind,
-                   bit_law, drive, gamma, c_a, c_v, h, q, q_pred, v_pred, x, anchor, held, trial_held, surface,
-                   surface_state, tangent)
-    norm = np.max(np.abs(ev[0]))
+    scale = max(_largest(gravity) * q.size, abs(drive[2]), 1.0)
+    offset = band_product(stiffness, w, q_pred) + band_product(damping, w, v_pred) - gravity
+    ev = _residual(base, offset, w, top, bit, wall_dofs, normal, arm, wall_law, bit_kind, bit_law, drive, c_v, h, q,
+                   q_pred, v_pred, x, anchor, held, trial_held, surface, surface_state, tangent)
+    norm = _largest(ev[0])
     for iteration in range(max_iterations):
         dx = band_solve(tangent, w, -ev[0])
-        cut = 1.0
-        for _ in range(BACKTRACKS + 1):
+        cut, at_kink = 1.0, False
+        for attempt in range(BACKTRACKS + 1):
             trial = x + cut * dx
-            trial_ev = _residual(mass, damping, stiffness, base, w, gravity, top, bit, wall_dofs, normal, arm, wall_law,
-                                 bit_kind, bit_law, drive, gamma, c_a, c_v, h, q, q_pred, v_pred, trial, anchor,
-                                 held, trial_held, surface, surface_state, tangent)
-            trial_norm = np.max(np.abs(trial_ev[0]))
-            if trial_norm < norm or trial_norm <= tolerance * scale:
+            trial_ev = _residual(base, offset, w, top, bit, wall_dofs, normal, arm, wall_law, bit_kind, bit_law, drive,
+                                 c_v, h, q, q_pred, v_pred, trial, anchor, held, trial_held, surface, surface_state,
+                                 tangent)
+            trial_norm = _largest(trial_ev[0])
+            if trial_norm < norm or trial_norm <= tolerance * scale or (at_kink and trial_norm <= norm):
                 break
-            cut *= 0.5
+            # the full update failed: next, the step just past the bit law's first kink along it (a branch the
+            # tangent did not see), taken if it does not raise the residual (solvers/newton.py's backtrack)
+            past = _kink(bit_kind, bit_law, ev, dx[bit[0]], dx[bit[1]], c_v) if attempt == 0 else math.inf
+            at_kink = past < cut
+            cut = past if at_kink else 0.5 * cut
         x, ev, norm = trial, trial_ev, trial_norm
-        if norm <= tolerance * scale or np.max(np.abs(cut * dx)) <= ROUND_OFF * (np.max(np.abs(x)) + 1.0):
+        if norm <= tolerance * scale or cut * _largest(dx) <= ROUND_OFF * (_largest(x) + 1.0):
             return True, x, ev, iteration + 1
     return False, x, ev, max_iterations
 
@@ -239,14 +278,18 @@ def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, a
     Newton iterations, steps halved), added to."""
     gamma = newmark[0]
     bu, bt = bit
-    tangent = np.empty_like(mass)
+    tangent, base = np.empty_like(mass), np.empty_like(mass)
+    base_step = 0.0  # the step size of ``base``
     trial_held = held.copy()
     rows = 0
     for step in range(steps):
         remaining, h = dt, dt
         while remaining > 1e-9 * dt:
             h = min(h, remaining)
-            ok, x, ev, iterations = _attempt(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm,
+            if h != base_step:
+                base[:, :] = stiffness + newmark[0] / (newmark[1] * h) * damping + 1.0 / (newmark[1] * h * h) * mass
+                base_step = h
+            ok, x, ev, iterations = _attempt(base, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm,
                                              wall_law, bit_kind, bit_law, drive, h, newmark, tolerance, max_iterations,
                                              q, v, a, clock[0], anchor, held, trial_held, surface, surface_state,
                                              tangent)

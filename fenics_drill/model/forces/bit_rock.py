@@ -91,14 +91,21 @@ def torque_regularisation_slope(omega):
 KINK_PAST = 1e-6
 
 
-def step_past_kink(value: float, change: float) -> float | None:
-    """The step s in (0, 1] that lands KINK_PAST of the change past where value + s change crosses zero
-    (None if it does not).  Past by a share of the change, not of the distance: an iterate resting on the
+@njit(cache=True)
+def fraction_past_kink(value: float, change: float) -> float:
+    """The step s in (0, 1] that lands KINK_PAST of the change past where value + s change crosses zero, or
+    infinity if it does not.  Past by a share of the change, not of the distance: an iterate resting on the
     kink (value ~ 1e-19 after round-off) must still land on the new branch, beyond the round-off of the
     velocity it is computed from."""
     if change == 0.0 or value * change > 0.0 or abs(change) <= abs(value):
-        return None
+        return math.inf
     return min(-value / change + KINK_PAST, 1.0)
+
+
+def step_past_kink(value: float, change: float) -> float | None:
+    """:func:`fraction_past_kink`, None where it crosses no kink."""
+    step = fraction_past_kink(float(value), float(change))
+    return None if step == math.inf else step
 
 
 @dataclass

@@ -34,7 +34,7 @@ import numpy as np
 from numba import njit
 
 from fenics_drill.model.discretization import THETA_X, U, BeamDiscretization
-from fenics_drill.model.forces.bit_rock import step_past_kink
+from fenics_drill.model.forces.bit_rock import fraction_past_kink
 from fenics_drill.model.forces.protocol import ForceEvaluation
 
 
@@ -106,6 +106,24 @@ def cutting_law(u, u_dot, omega, cut, slope, blades, zeta_eps_a, eps_a2_half, co
     return (d, -weight, -magnitude * s - held * omega, -weight_by_d * dd_u, -weight_by_d * dd_phi,
             -torque_by_d * dd_u, -torque_by_d * dd_phi, -d_contact_v, -torque_arm * d_contact_v * s,
             -magnitude * ds / spin_scale - held)
+
+
+@njit(cache=True)
+def cutting_law_kink(u_dot, omega, clearance, slope, du, dphi, c_v, blades, contact_velocity, contact_depth,
+                     spin_scale, backward_damping):
+    """The fraction of a Newton update (du, dphi) of the bit's (u, phi), which moves its rates by c_v (du, dphi),
+    just past the first kink of :func:`cutting_law`'s clipped ramps along it, linearised
+    (:func:`~fenics_drill.model.forces.bit_rock.fraction_past_kink`): the spin's at omega = -v_c / a, v_c / a (and 0
+    with a held backward spin), the wear flats' at u_dot = 0, v_c and at the clearance u - S = 0, d_c / n (which
+    moves by du - dS/dphi dphi); infinity if it crosses none."""
+    step = min(fraction_past_kink(omega - -spin_scale, c_v * dphi), fraction_past_kink(omega - spin_scale, c_v * dphi))
+    if backward_damping > 0:
+        step = min(step, fraction_past_kink(omega - 0.0, c_v * dphi))
+    for kink in (0.0, contact_velocity):
+        step = min(step, fraction_past_kink(u_dot - kink, c_v * du))
+    for kink in (0.0, contact_depth / blades):
+        step = min(step, fraction_past_kink(clearance - kink, du - slope * dphi))
+    return step
 
 
 class CutSurface:
@@ -266,12 +284,9 @@ class CuttingBit:
         du, dphi = (float(v) for v in self.rows.values(dq))
         (u_dot, omega), (clearance, slope) = forces.rates, forces.clearance
         blades, *_, contact_velocity, contact_depth, spin_scale, backward_damping = self.law_constants
-        spins = (-spin_scale, spin_scale, 0.0) if backward_damping > 0 else (-spin_scale, spin_scale)
-        crossings = [(omega - k, c_v * dphi) for k in spins]
-        crossings += [(u_dot - k, c_v * du) for k in (0.0, contact_velocity)]
-        crossings += [(clearance - k, du - slope * dphi) for k in (0.0, contact_depth / blades)]
-        steps = [s for s in (step_past_kink(value, change) for value, change in crossings) if s is not None]
-        return min(steps) if steps else None
+        step = cutting_law_kink(float(u_dot), float(omega), float(clearance), float(slope), du, dphi, c_v, blades,
+                                contact_velocity, contact_depth, spin_scale, backward_damping)
+        return None if step == math.inf else step
 
     def tangent(self, forces: CuttingForces, c_u: float, c_v: float):
         """c_u df/dq + c_v df/dqd: the 2 x 2 law Jacobians at the bit, projected."""
