@@ -98,10 +98,18 @@ def first_torsional_period(string: AxialTorsionalString) -> float:
     return 4.0 * string.length / string.torsional_wave_speed_at_top
 
 
+#: The default step's share of the mean element's axial wave transit time.  At the whole transit, three of the twelve
+#: points of a grid of weight on bit x rotation speed next to bit bounce settled on a calm cycle where the distributed
+#: model solved exactly bounces; at half of it none did, and the fastest spin and the stuck share came closer to the
+#: exact ones (benchmarks/results/stick_slip_waves.md, docs/guide/stick_slip_maps.md).
+TRANSIT_SHARE = 0.5
+
+
 def default_step(string: AxialTorsionalString) -> float:
-    """The mean element's axial wave transit time, (L / elements) / c_L [s] (``time.dt = -1``): short elements
-    (a stabiliser's 2 m) do not set it, for the scheme is implicit (its accuracy is measured in docs/performance.md)."""
-    return float(string.length / (len(string.wall_dofs) - 1) / string.axial_wave_speed)
+    """TRANSIT_SHARE of the mean element's axial wave transit time, (L / elements) / c_L [s] (``time.dt = -1``): short
+    elements (a stabiliser's 2 m) do not set it, for the scheme is implicit (its accuracy is measured in
+    docs/performance.md)."""
+    return float(TRANSIT_SHARE * string.length / (len(string.wall_dofs) - 1) / string.axial_wave_speed)
 
 
 def _bit_law(scene, string: AxialTorsionalString) -> tuple[int, np.ndarray]:
