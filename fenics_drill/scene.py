@@ -168,8 +168,8 @@ class Drive:
 @dataclass(frozen=True)
 class Time:
     t_end: float = key(10.0, "end of the simulated interval [s]", lambda x: 1e-6 <= x <= 1e6, "in [1e-6, 1e6]")
-    dt: float = key(-1.0, "nominal time step; -1: 1/(time.band_steps f_max), f_max = f*_max c_L / L (in a "
-                    "stick-slip map: half the mean element's axial wave transit time) [s]",
+    dt: float = key(-1.0, "time step; -1: 1/(time.band_steps f_max), f_max = f*_max c_L / L (maps: half an axial "
+                    "transit) [s]",
                     lambda x: x == -1.0 or 1e-9 <= x <= 10.0, "in [1e-9, 10] (or -1 for the nominal step of "
                     "time.band_steps)")
     band_steps: float = key(8.0, "steps per period of f_max in the nominal step (2: the paper's 1/(2 f_max)) [-]",
