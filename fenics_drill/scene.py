@@ -125,6 +125,14 @@ class Contact:
     stick_stiffness: float = _pos("k_t, the tangential spring of a stuck contact (the Coulomb force below mu |F_n|) "
                                   "[N/m]", 1e8)
     culling: bool = key(True, "evaluate the wall law only where a vertex can reach the wall (exact)")
+    static_friction: float = key(-1.0, "the wall's static friction factor where lateral fields are not solved; -1: "
+                                 "contact.friction [-]", lambda x: x == -1 or x >= 0, "-1 or >= 0")
+    static_slip_speed: float = _nonneg("slip speed below which the static factor holds a sliding contact [m/s]", 0.0)
+
+    @property
+    def static_factor(self) -> float:
+        """The static friction factor: ``static_friction``, or ``friction`` where it is -1."""
+        return self.friction if self.static_friction < 0 else self.static_friction
 
 @dataclass(frozen=True)
 class BitRock:
@@ -838,6 +846,15 @@ def _check_relations(scene: Scene) -> Scene:
                          "not admissible with model.lateral_length = -1: the whole string carries its lateral fields "
                          "(set model.lateral_length to the length above the bit that needs them, or 0)")
     contact = scene.contact
+    if contact.static_friction >= 0:
+        if contact.static_friction < contact.friction:
+            raise SceneError(f"contact.static_friction = {contact.static_friction!r} is not admissible: must be >= "
+                             f"contact.friction = {contact.friction!r} (the static factor holds a stuck contact)")
+        if contact.static_friction != contact.friction and scene.model.lateral_length != 0:
+            raise SceneError(f"contact.static_friction = {contact.static_friction!r} is not admissible with "
+                             f"model.lateral_length = {scene.model.lateral_length!r}: the lateral wall has one "
+                             "friction factor, contact.friction; the static one acts on the axial-torsional string "
+                             "(model.lateral_length = 0)")
     if contact.friction_model == "coulomb":
         for name in ("axial_friction_law", "friction_torque_law"):
             if scene.law(getattr(contact, name)) == "printed":

@@ -68,11 +68,15 @@ def test_cli_reports_scene_errors_before_computing(tmp_path, capsys):
         (["drive.mode=hook_load", "model.bit_rock=false"], ["hook_load", "model.bit_rock"]),
         (["bit_rock.law=detournay", "bit_rock.bit_radius=0.2"], ["bit_rock.bit_radius", "0.2", "borehole.radius"]),
         (["drive.controller=fast"], ["drive.controller", "fast", "stiff, pi, soft_torque"]),
+        (["model.lateral_length=0", "contact.static_friction=0.1"], ["contact.static_friction", "0.1", ">= "
+                                                                     "contact.friction"]),
+        (["contact.static_friction=0.4"], ["contact.static_friction", "model.lateral_length", "lateral wall"]),
     ],
 )
 def test_drives_and_bit_laws_that_cannot_work_are_refused(overrides, words):
     """A hook load the paper's law (20) cannot hold (W >= Gamma_BR: the bit would accelerate without bound),
-    a pushed string with nothing at the bit, a bit wider than its hole."""
+    a pushed string with nothing at the bit, a bit wider than its hole, a static wall friction below the kinetic
+    one, or one asked of the lateral wall (which has one factor)."""
     with pytest.raises(SceneError) as err:
         load_scene(PAPER, overrides)
     for word in words:

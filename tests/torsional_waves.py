@@ -34,8 +34,29 @@ def _regularisation(omega):
 
 
 @njit(cache=True)
-def _march(impedance, omega_top, damping, dt, steps, stride, torque_scale, drive):
+def _wall_friction(f, g, friction, sliding):
+    """The wall's Coulomb friction along the string over one step, cell by cell (:func:`torsional_stick_slip`):
+    ``friction[k]`` = (the static and the kinetic impulse per step, as the spin they take from the cell, and the
+    spin below which a sliding cell is held at the static one); ``sliding[k]``: (1 if it slid at the last step, its
+    spin there).  A cell whose spin the step's impulse can take away stops; another loses that spin.  The impulse
+    changes f and g alike, so the torque Z (g - f) is untouched."""
+    for k in range(f.size):
+        static, kinetic, slow = friction[k, 0], friction[k, 1], friction[k, 2]
+        if static == 0.0:
+            continue
+        cap = kinetic if sliding[k, 0] > 0.5 and abs(sliding[k, 1]) >= slow else static
+        spin = f[k] + g[k]
+        taken = spin if abs(spin) <= cap else math.copysign(cap, spin)
+        f[k] -= 0.5 * taken
+        g[k] -= 0.5 * taken
+        sliding[k, 0] = 1.0 if abs(spin) > cap else 0.0
+        sliding[k, 1] = spin - taken
+
+
+@njit(cache=True)
+def _march(impedance, omega_top, damping, dt, steps, stride, torque_scale, drive, friction):
     n = impedance.size
+    sliding = np.zeros((n, 2))  # at rest on the wall: stuck, held at the static factor
     f = np.full(n, 0.5 * omega_top)  # the string turning at Omega, untwisted: f = g = Omega / 2 in every cell
     g = np.full(n, 0.5 * omega_top)
     f_next, g_next = np.empty(n), np.empty(n)
@@ -86,6 +107,7 @@ def _march(impedance, omega_top, damping, dt, steps, stride, torque_scale, drive
         g_next[n - 1] = spin - incoming
         for k in range(n):
             f[k], g[k] = f_next[k], g_next[k]
+        _wall_friction(f, g, friction, sliding)
         if step % stride == 0:
             out[row, 0], out[row, 1], out[row, 2] = step * dt, spin, top_torque
             row += 1
@@ -93,7 +115,8 @@ def _march(impedance, omega_top, damping, dt, steps, stride, torque_scale, drive
 
 
 def torsional_stick_slip(sections, rotation_speed: float, damping: float, torque_scale: float, duration: float,
-                         cell: float = 1.0, stride: int = 10, top_drive: tuple = (0.0, 0.0, 0.0, math.inf)) -> dict:
+                         cell: float = 1.0, stride: int = 10, top_drive: tuple = (0.0, 0.0, 0.0, math.inf),
+                         wall: tuple | None = None) -> dict:
     """The bit's spin and the drive's torque over ``duration`` [s] from the string turning untwisted at
     ``rotation_speed`` [rad/s], every ``stride`` steps: {"time", "bit_angular_velocity", "top_torque"}.
 
@@ -101,7 +124,14 @@ def torsional_stick_slip(sections, rotation_speed: float, damping: float, torque
     the bit's torque -``torque_scale`` xi(omega) [N m]; ``cell``: the grid's dx [m], which divides every length;
     ``top_drive``: (J [kg m^2], k_p [N m s/rad], k_i [N m/rad], T_max [N m]) of a top drive turned by the motor torque
     T_m = k_p (Omega - top) + k_i z, z the speed error's integral, frozen while |T_m| is at T_max (J = 0: the top
-    held at Omega); the top torque is then T_m."""
+    held at Omega); the top torque is then T_m.
+
+    ``wall``: (static factor, kinetic factor, static slip speed [m/s], and per section the wall's normal force per
+    length [N/m] and the contact radius R [m]): Coulomb friction along the string, the torque per length mu N' R
+    acting on each cell's spin, the kinetic factor where the cell slid at the last step at a surface speed R |omega|
+    of at least the static slip speed, the static one elsewhere (the wall law of Aarsnes & Shor, J. Pet. Sci. Eng.
+    163, 2018, with its threshold on the surface speed): a cell stops when the step's impulse of friction can take
+    its spin away (:func:`_wall_friction`)."""
     speeds = [math.sqrt(rigidity / inertia) for _, rigidity, inertia in sections]
     if max(speeds) - min(speeds) > 1e-9 * max(speeds):
         raise ValueError("the sections' torsional wave speeds differ: the grid needs one")
@@ -112,8 +142,17 @@ def torsional_stick_slip(sections, rotation_speed: float, damping: float, torque
             raise ValueError(f"a cell of {cell} m does not divide a section of {length} m")
         impedance += [math.sqrt(rigidity * inertia)] * cells
     dt = cell / speeds[0]
+    friction = np.zeros((len(impedance), 3))
+    if wall is not None:
+        static, kinetic, slow_speed, per_section = wall
+        k = 0
+        for (length, _, inertia), (normal, radius) in zip(sections, per_section):
+            cells = round(length / cell)
+            per_step = normal * radius * dt / inertia  # the spin mu = 1 takes per step: N' R dt / (rho I_p)
+            friction[k:k + cells] = (static * per_step, kinetic * per_step, slow_speed / radius)
+            k += cells
     rows = _march(np.array(impedance), rotation_speed, damping, dt, int(round(duration / dt)), stride, torque_scale,
-                  np.array(top_drive, dtype=float))
+                  np.array(top_drive, dtype=float), friction)
     return {"time": rows[:, 0], "bit_angular_velocity": rows[:, 1], "top_torque": rows[:, 2]}
 
 
@@ -404,3 +443,42 @@ def vertical_cutting_law_case(elements: int = 200, weight_on_bit: float = 60e3, 
                                           scene.environment.gravity, law, duration, cell, max(1, round(10 / cell)))
 
     return scene, reference
+
+
+def inclined_wall_friction_case(elements: int = 200, inclination: float = 60.0, controller: str = "stiff"):
+    """(scene, reference, static torque): the 2000 m string of demos/scenes/vertical_2000m.toml (``elements`` over
+    its length) in a straight hole inclined ``inclination`` degrees, in air, rotating off bottom at 40 rpm with the
+    wall's static factor 0.3, kinetic 0.195 and static slip speed 0.11 m/s (the ratio 0.65 and the threshold, 1.5
+    rad/s on a 5 3/4 in pipe, of Aarsnes & Shor 2018), and ``reference(duration, cell)``: :func:`torsional_stick_slip`
+    of its sections with the wall's normal force per length rho g A sin(inclination) (a straight hole: the string's
+    weight across it) at the outer radius; the static torque is sum mu_s N' R L over the sections."""
+    import fenics_drill as fd
+
+    scene = fd.load_scene("demos/scenes/vertical_2000m.toml", [
+        f"well.inclination=[{inclination}, {inclination}]", "fluid.density=0.0", "model.bit_rock=false",
+        "drive.mode='velocity'", "drive.axial_velocity=0.0", "drive.start='off_bottom'", "drive.rotation_speed='40 rpm'",
+        "model.lateral_length=0", "contact.friction=0.195", "contact.static_friction=0.3",
+        "contact.static_slip_speed=0.11", f"beam.elements={elements}", f"drive.controller='{controller}'",
+        "drive.top_drive_inertia=2900.0", "drive.proportional_gain=38e3", "drive.integral_gain=100e3",
+        "drive.torque_limit=100e3"])
+    beam, drive, contact = scene.beam, scene.drive, scene.contact
+    shear = beam.young_modulus / (2.0 * (1.0 + beam.poisson_ratio))
+    sections, wall = [], []
+    for section in reversed(scene.string.sections):  # the scene lists them from the bit up
+        outer, inner = section["outer_radius"], section["inner_radius"]
+        polar = math.pi / 2.0 * (outer**4 - inner**4)
+        sections.append((section["length"], shear * polar, beam.density * polar))
+        weight = beam.density * scene.environment.gravity * math.pi * (outer**2 - inner**2)
+        wall.append((weight * math.sin(math.radians(inclination)), outer))
+    top_drive = (0.0, 0.0, 0.0, math.inf)
+    if controller == "pi":
+        top_drive = (drive.top_drive_inertia, drive.proportional_gain, drive.integral_gain, drive.torque_limit)
+    law = (contact.static_friction, contact.friction, contact.static_slip_speed, wall)
+    static_torque = sum(contact.static_friction * normal * radius * length
+                        for (length, _, _), (normal, radius) in zip(sections, wall))
+
+    def reference(duration: float, cell: float = 1.0) -> dict:
+        return torsional_stick_slip(sections, drive.rotation_speed, beam.damping, 0.0, duration, cell,
+                                    max(1, round(10 / cell)), top_drive, law)
+
+    return scene, reference, static_torque

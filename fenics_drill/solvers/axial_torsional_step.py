@@ -10,7 +10,9 @@ jumps the wear flats' contact ramp (v_c wide) otherwise cycles between its branc
 
 * **Wall**: at each vertex the Coulomb force at the contact point by return mapping
   (:func:`~fenics_drill.model.forces.wall.coulomb._return_map`, the FE wall's law), its slip (du, R d theta_x)
-  since the step's start and its stuck spring k_t.
+  since the step's start and its stuck spring k_t; its factor kinetic where the vertex slid at the last step at
+  least as fast as the static slip speed, static elsewhere
+  (:mod:`~fenics_drill.model.forces.axial_torsional_wall`).
 * **Bit**: the paper's law (20)-(22) (:data:`~fenics_drill.model.forces.bit_rock.LAW`) or the cutting law
   (:func:`~fenics_drill.model.forces.cutting_bit.cutting_law`) over the bottom surface one blade passage behind,
   kept here as the accepted steps' (angle, surface) where the bit turned further than ever before.
@@ -96,22 +98,25 @@ def band_solve(band, w, rhs):
 
 
 @njit(cache=True)
-def _wall(q, wall_dofs, normal, arm, friction, stick_stiffness, anchor, held, residual, tangent, w):
-    """The wall's Coulomb forces at every vertex: subtracted from ``residual``, their derivatives from
-    ``tangent``; ``held`` becomes the forces.  Returns how many vertices stick."""
+def _wall(q, wall_dofs, normal, arm, stick_stiffness, anchor, held, residual, tangent, w):
+    """The wall's Coulomb forces at every vertex, at its factor ``held[k, 2]``: subtracted from ``residual``, their
+    derivatives from ``tangent``; ``held[k, :2]`` becomes the forces and ``held[k, 3]`` 1 where it slides, else 0.
+    Returns how many vertices stick."""
     stuck = 0
     for k in range(normal.size):
         iu, it = wall_dofs[k, 0], wall_dofs[k, 1]
         r = arm[k]
+        friction = held[k, 2]
         cap = friction * abs(normal[k])
         if cap == 0.0:  # off the wall: no friction
-            held[k, 0], held[k, 1] = 0.0, 0.0
+            held[k, 0], held[k, 1], held[k, 3] = 0.0, 0.0, 0.0
             continue
         g_a, g_t = q[iu] - anchor[k, 0], r * (q[it] - anchor[k, 1])
         f_a, f_t, size = _return_map(normal[k], held[k, 0], held[k, 1], g_a, g_t, friction, stick_stiffness)
         residual[iu] -= f_a
         residual[it] -= r * f_t
         kt = stick_stiffness
+        held[k, 3] = 1.0 if size > cap else 0.0
         if size <= cap:
             aa, at, tt = -kt, 0.0, -kt
             stuck += 1
@@ -147,7 +152,7 @@ def _residual(base, offset, w, top, bit, wall_dofs, normal, arm, wall_law, bit_k
     residual = band_product(base, w, increment) + offset
     tangent[:, :] = base
     trial_held[:, :] = held
-    stuck = _wall(x, wall_dofs, normal, arm, wall_law[0], wall_law[1], anchor, trial_held, residual, tangent, w)
+    stuck = _wall(x, wall_dofs, normal, arm, wall_law[1], anchor, trial_held, residual, tangent, w)
     tu, tt = top
     bu, bt = bit
     bit_velocity, bit_spin = v_pred[bu] + c_v * increment[bu], v_pred[bt] + c_v * increment[bt]
@@ -270,10 +275,10 @@ def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, a
     row of :data:`RECORDED` into ``records`` every ``stride`` steps.  A step whose Newton does not converge is
     taken in halves (down to dt / 2 ** :data:`SUBSTEP_HALVINGS`).  Returns (status, rows written).
 
-    ``wall_law``: (friction, stick stiffness); ``bit_law``: the law's constants (:data:`PAPER`: Gamma, alpha,
+    ``wall_law``: (kinetic factor, stick stiffness, static factor, static slip speed); ``bit_law``: the law's constants (:data:`PAPER`: Gamma, alpha,
     mu, R; :data:`CUTTING`: :func:`~fenics_drill.model.forces.cutting_bit.cutting_law_constants` then the blade
     passage); ``drive``: (axial held, V0, top force, rotation held, Omega, k_p, k_i, T_max, z); ``anchor``,
-    ``held``: each vertex's (u, theta_x) and (F_a, F_t) at the last step; ``surface``: (2, capacity) angles and
+    ``held``: each vertex's (u, theta_x), and (F_a, F_t, factor for the next step, 1 if sliding) at the last step; ``surface``: (2, capacity) angles and
     surfaces of the cut bottom with ``surface_state`` = (count, pruned, feed per radian); ``counters``: (steps,
     Newton iterations, steps halved), added to."""
     gamma = newmark[0]
@@ -310,6 +315,7 @@ def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, a
             anchor[:, 0] = x[wall_dofs[:, 0]]
             anchor[:, 1] = x[wall_dofs[:, 1]]
             held[:, :] = trial_held
+            _next_factors(held, v, wall_dofs, arm, wall_law)
             drive[8] = ev[7]
             clock[0] += h
             remaining -= h
@@ -321,6 +327,16 @@ def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, a
             row[9], row[10] = ev[3], ev[4]
             rows += 1
     return CONVERGED, rows
+
+
+@njit(cache=True)
+def _next_factors(held, v, wall_dofs, arm, wall_law):
+    """Each vertex's factor for the next step (:mod:`~fenics_drill.model.forces.axial_torsional_wall`): kinetic
+    where it slid at least as fast as the static slip speed, static elsewhere."""
+    kinetic, static, static_speed = wall_law[0], wall_law[2], wall_law[3]
+    for k in range(held.shape[0]):
+        speed = math.hypot(v[wall_dofs[k, 0]], arm[k] * v[wall_dofs[k, 1]])
+        held[k, 2] = kinetic if held[k, 3] > 0.5 and speed >= static_speed else static
 
 
 @njit(cache=True)

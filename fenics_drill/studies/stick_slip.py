@@ -158,11 +158,14 @@ def start(scene, string: AxialTorsionalString | None = None, dt: float | None = 
     surface[:, 0] = q[bt], q[bu]
     feed = drive.axial_velocity / drive.rotation_speed if drive.rotation_speed > 0 else 0.0
     wall = string.wall_dofs
-    state = (q, v, np.zeros(n), np.zeros(1), np.stack([q[wall[:, 0]], q[wall[:, 1]]], axis=1),
-             np.zeros((len(wall), 2)), surface, np.array([1.0, 0.0, feed]))
+    contact = scene.contact
+    held = np.zeros((len(wall), 4))  # (F_a, F_t, factor, sliding) of each vertex: at rest, stuck at the static factor
+    held[:, 2] = contact.static_factor
+    state = (q, v, np.zeros(n), np.zeros(1), np.stack([q[wall[:, 0]], q[wall[:, 1]]], axis=1), held, surface,
+             np.array([1.0, 0.0, feed]))
+    wall_law = np.array([contact.friction, contact.stick_stiffness, contact.static_factor, contact.static_slip_speed])
     constants = (mass, string.damping, string.stiffness, w, string.gravity, string.top, string.bit, wall,
-                 string.wall_normal, string.wall_arm,
-                 (scene.contact.friction, scene.contact.stick_stiffness), bit_kind, bit_law)
+                 string.wall_normal, string.wall_arm, wall_law, bit_kind, bit_law)
     drive_state = np.array([float(axial_held), drive.axial_velocity, -hook_load, float(rotation_held),
                             drive.rotation_speed, k_p, k_i, drive.torque_limit, 0.0])
     return Simulation(string, float(dt), newmark_parameters(scene.time.newmark_alpha), constants, drive_state, state,
@@ -201,11 +204,13 @@ def window_metrics(series: dict, rotation_speed: float) -> dict:
 def cycles(series: dict, rotation_speed: float) -> list[slice]:
     """The rows of each whole cycle of the bit's spin: from one rise through the drive's speed to the next, a rise
     counting only after the spin has fallen a quarter of its range below that speed (a chattering crossing is not
-    a cycle)."""
+    a cycle), or, where that is below its slowest, to a quarter of the way from its slowest to that speed (a spin
+    that peaks above three times the drive's speed still has cycles)."""
     spin = series["bit_angular_velocity"]
     if spin.size < 2:
         return []
-    low = rotation_speed - 0.25 * np.ptp(spin)
+    slowest = spin.min()
+    low = max(rotation_speed - 0.25 * np.ptp(spin), slowest + 0.25 * (rotation_speed - slowest))
     rises, armed = [], False
     for i in range(1, spin.size):
         if spin[i] < low:

@@ -11,6 +11,12 @@ return mapping of the FE wall (:func:`~fenics_drill.model.forces.wall.coulomb.co
 held at the step's start, the trial F* = F_0 - k_t g of the slip g since then, kept while |F*| <= mu N_i (stuck: no
 creep under a force below the cone), scaled onto the cone above it (sliding against the slip, so that rotation
 takes the axial drag away).  On the string it acts as F_a on u_i and R_i F_t on theta_x,i.
+
+The cone's factor mu is the kinetic ``contact.friction`` at a vertex that slid at the last accepted state at a slip
+speed of at least ``contact.static_slip_speed``, and the static ``contact.static_friction`` elsewhere (at rest, stuck,
+or slipping slower): a stuck string breaks loose at the static factor and slides at the kinetic one (the wall law of
+Aarsnes & Shor 2018, whose threshold is on the pipe's spin).  The factor is set at each accepted state and held
+through the next step's Newton iterations.
 """
 
 from __future__ import annotations
@@ -66,18 +72,22 @@ class AxialTorsionalWall:
                                                                     "(axial-torsional length)")}
 
     def __init__(self, disc: BeamDiscretization, space, normal: np.ndarray, arm: np.ndarray, friction: float,
-                 stick_stiffness: float):
+                 stick_stiffness: float, static_friction: float | None = None, static_slip_speed: float = 0.0):
         self.vertices = np.flatnonzero(disc.vertex_x < disc.lateral_top - 1e-9 * disc.properties.length) \
             if disc.lateral_length != 0 else np.arange(len(disc.vertex_x))
         self.rows = space.point_rows(np.concatenate([disc.vertex_dofs(U)[self.vertices],
                                                      disc.vertex_dofs(THETA_X)[self.vertices]]))
         self.normal, self.arm = normal[self.vertices], arm[self.vertices]
         self.friction, self.stick_stiffness = friction, stick_stiffness
+        self.static_friction = friction if static_friction is None else static_friction
+        self.static_slip_speed = static_slip_speed
         # the return mapping's arguments as its compiled kernel takes them
         self._normal_force = np.ascontiguousarray(-self.normal, dtype=float)
-        self._friction, self._stick_stiffness = float(friction), float(stick_stiffness)
+        self._stick_stiffness = float(stick_stiffness)
         self.space = space
-        self._history = None  # (u, theta_x) and (F_a, F_t) at the last accepted state; None outside a run
+        # (u, theta_x), (F_a, F_t) and each vertex's factor for the next step (module doc) at the last accepted
+        # state; None outside a run
+        self._history = None
 
     @classmethod
     def chosen(cls, scene) -> bool:
@@ -87,8 +97,9 @@ class AxialTorsionalWall:
     @classmethod
     def from_scene(cls, scene, disc, space, operators) -> "AxialTorsionalWall":
         contact_radius, _ = disc.vertex_radii(scene.borehole.radius)
-        return cls(disc, space, vertex_normal_forces(scene, disc.vertex_x), contact_radius, scene.contact.friction,
-                   scene.contact.stick_stiffness)
+        contact = scene.contact
+        return cls(disc, space, vertex_normal_forces(scene, disc.vertex_x), contact_radius, contact.friction,
+                   contact.stick_stiffness, contact.static_factor, contact.static_slip_speed)
 
     def fresh(self) -> "AxialTorsionalWall":
         """A copy whose friction has no memory yet (a simulation's results never depend on another's)."""
@@ -104,15 +115,20 @@ class AxialTorsionalWall:
     def begin(self, t: float, q: np.ndarray) -> None:
         """Anchor the friction at the initial state, holding no force yet."""
         u, theta = self._positions(q)
-        self._history = (u, theta, np.zeros_like(u), np.zeros_like(u))
+        self._history = (u, theta, np.zeros_like(u), np.zeros_like(u), np.full(u.size, float(self.static_friction)))
 
     def accept(self, t: float, q: np.ndarray, qd: np.ndarray) -> None:
-        """Anchor the friction at an accepted state, holding the force each vertex feels there."""
+        """Anchor the friction at an accepted state, holding the force each vertex feels there, and set each
+        vertex's factor for the next step (module doc)."""
         if self._history is None:
             return
         forces = self.evaluate(q, qd)
         u, theta = self._positions(q)
-        self._history = (u, theta, forces.axial, forces.tangential)
+        axial_speed, spin = self._positions(qd)
+        sliding = forces.trial > self._history[4] * np.abs(self.normal)
+        fast = np.hypot(axial_speed, self.arm * spin) >= self.static_slip_speed
+        factor = np.where(sliding & fast, float(self.friction), float(self.static_friction))
+        self._history = (u, theta, forces.axial, forces.tangential, factor)
 
     def evaluate(self, q: np.ndarray, qd: np.ndarray, with_tangent: bool = False) -> AxialTorsionalWallForces:
         n = self.vertices.size
@@ -121,11 +137,11 @@ class AxialTorsionalWall:
             return AxialTorsionalWallForces(np.zeros(self.space.size), 0.0, {self.name: np.zeros(self.space.size)},
                                             zero, zero, zero)
         u, theta = self._positions(q)
-        u0, theta0, held_a, held_t = self._history
+        u0, theta0, held_a, held_t, factor = self._history
         axial_slip, tangential_slip = u - u0, self.arm * (theta - theta0)
         trial_a = held_a - self.stick_stiffness * axial_slip
         trial_t = held_t - self.stick_stiffness * tangential_slip
-        f_a, f_t = _return_maps(self._normal_force, held_a, held_t, axial_slip, tangential_slip, self._friction,
+        f_a, f_t = _return_maps(self._normal_force, held_a, held_t, axial_slip, tangential_slip, factor,
                                 self._stick_stiffness)
         generalised = self.rows.spread(np.concatenate([f_a, self.arm * f_t]))
         return AxialTorsionalWallForces(generalised, 0.0, {self.name: generalised}, f_a, f_t,
@@ -137,7 +153,7 @@ class AxialTorsionalWall:
         n = self.vertices.size
         if self._history is None or n == 0:
             return None
-        uu, ut, tt = _vertex_blocks(forces.trial, forces.axial, forces.tangential, self.normal, self._friction,
+        uu, ut, tt = _vertex_blocks(forces.trial, forces.axial, forces.tangential, self.normal, self._history[4],
                                     self._stick_stiffness, float(c_u), self.arm)
         if self.space.sparse:
             where = self.rows.positions
@@ -148,20 +164,21 @@ class AxialTorsionalWall:
                 + rt.T @ (tt[:, None] * rt))
 
     def record(self, forces: AxialTorsionalWallForces) -> dict[str, float]:
-        cap = self.friction * np.abs(self.normal)
+        factor = self.static_friction if self._history is None else self._history[4]  # at rest: static
+        cap = factor * np.abs(self.normal)
         stuck = np.count_nonzero((forces.trial <= cap) & (cap > 0)) if forces.trial is not None else 0
         return {"vertices_stuck_on_the_wall": int(stuck)}
 
 
 @kernel
 def _vertex_blocks(trial, axial, tangential, normal, friction, stick_stiffness, c_u, arm):
-    """Each vertex's 2 x 2 block [[uu, ut], [ut, tt]] of c_u d(F_a, R F_t)/d(u, theta_x)
+    """Each vertex's 2 x 2 block [[uu, ut], [ut, tt]] of c_u d(F_a, R F_t)/d(u, theta_x), ``friction`` its factor
     (:meth:`AxialTorsionalWall.tangent`): d(F_a, F_t)/d(g_a, g_t) = k (I - s e e^T) with k = -c_u k_t |F|/|F*| and
     s = 1 sliding (k = -c_u k_t, s = 0 stuck), g = (u, R theta_x): the rows of theta_x carry R, its columns R."""
     n = trial.size
     uu, ut, tt = np.empty(n), np.empty(n), np.empty(n)
     for i in range(n):
-        cap = friction * abs(normal[i])
+        cap = friction[i] * abs(normal[i])
         sliding = trial[i] > cap
         shrink = cap / max(trial[i], 1e-300) if sliding else 1.0
         e_a = axial[i] / max(cap, 1e-300) if sliding else 0.0

@@ -31,19 +31,19 @@ def coulomb_friction(normal_force, held_axial, held_tangential, axial_slip, tang
     |F| <= mu |F_n|, the stuck contact's spring k_t below it and the cone's surface, opposing the trial's slip,
     above; the arguments broadcast as NumPy's arrays do."""
     arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (normal_force, held_axial, held_tangential,
-                                                                          axial_slip, tangential_slip)))
+                                                                          axial_slip, tangential_slip, friction)))
     flat = [np.ascontiguousarray(a).ravel() for a in arrays]
-    axial, tangential = _return_maps(*flat, float(friction), float(stick_stiffness))
+    axial, tangential = _return_maps(*flat, float(stick_stiffness))
     return axial.reshape(arrays[0].shape), tangential.reshape(arrays[0].shape)
 
 
 @kernel
 def _return_maps(normal_force, held_axial, held_tangential, axial_slip, tangential_slip, friction, stick_stiffness):
-    """:func:`_return_map` at each entry of the arrays."""
+    """:func:`_return_map` at each entry of the arrays (``friction`` too: each contact's factor)."""
     axial, tangential = np.empty(normal_force.size), np.empty(normal_force.size)
     for i in range(normal_force.size):
         axial[i], tangential[i], _ = _return_map(normal_force[i], held_axial[i], held_tangential[i], axial_slip[i],
-                                                 tangential_slip[i], friction, stick_stiffness)
+                                                 tangential_slip[i], friction[i], stick_stiffness)
     return axial, tangential
 
 
