@@ -14,7 +14,10 @@ default) at 0 and 0.1 shows what the scheme's own dissipation does to the cycle.
 the cutting law under its hook-load drive at two points, against the axial and torsional wave guides that meet in
 the law at the bit; the reference on three grids shows how sharply this coupled cycle is defined.  Last, a grid of
 weight on bit x rotation speed with the cutting law, as a stick-slip map would take it, the bit free and held, and the
-points where the compiled steps stay calm while the wave guides bounce, at the default step and at twice it.
+points where the compiled steps stay calm while the wave guides bounce, at the default step and at twice it.  And the
+same string rotating off bottom in a straight hole inclined 60 degrees, with the wall's static friction (static factor
+0.3, kinetic 0.195): the off-bottom torsional oscillation of Aarsnes & Shor (2018), against the wave guides with the
+same wall law cell by cell.
 """
 
 from __future__ import annotations
@@ -32,7 +35,8 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from speed import processor  # noqa: E402
-from torsional_waves import limit_cycle_statistics, vertical_cutting_law_case, vertical_paper_law_case  # noqa: E402
+from torsional_waves import (inclined_wall_friction_case, limit_cycle_statistics, vertical_cutting_law_case,  # noqa: E402
+                             vertical_paper_law_case)
 
 from fenics_drill.model.axial_torsional_string import axial_torsional_string  # noqa: E402
 from fenics_drill.studies.stick_slip import default_step, start  # noqa: E402
@@ -146,8 +150,8 @@ def main() -> None:
                     calm_where_bouncing.append((step, weight, speed, cell))
     lines += ["", "The same grid with the bit held against turning backwards (`bit_rock.backward_spin = 'held'`, a damper of "
               "1e6 N m s in both; \"no cycle\": no two rises of the spin through the drive's speed, each after a fall a "
-              "quarter of its range below it):", "", "| weight on bit [kN] | rotation speed [rpm] | compiled steps | "
-              "wave guides |", "|---|---|---|---|"]
+              "quarter of its range below it, or where that is below its slowest a quarter of the way from it):", "",
+              "| weight on bit [kN] | rotation speed [rpm] | compiled steps | wave guides |", "|---|---|---|---|"]
     for weight in MAP_WEIGHTS:
         for speed in MAP_SPEEDS:
             scene, reference = vertical_cutting_law_case(200, weight * 1e3, speed * math.pi / 30.0, "held")
@@ -161,6 +165,16 @@ def main() -> None:
     if not any(step == "default" for step, *_ in calm_where_bouncing):
         lines.append("| default | none | | |")
     lines += [f"| {step} | {weight} | {speed} | {cell} |" for step, weight, speed, cell in calm_where_bouncing]
+    for controller in ("stiff", "pi"):
+        def case(elements, controller=controller):
+            return inclined_wall_friction_case(elements, controller=controller)[:2]
+
+        lines += ["", f"**The wall's static friction, off bottom**: the same string in air in a straight hole inclined 60 "
+                  "degrees, rotating off bottom at 40 rpm with the wall's static factor 0.3, kinetic 0.195 and static slip "
+                  f"speed 0.11 m/s, `drive.controller = '{controller}'` (J_td 2900 kg m^2, k_p 38 kN m s, k_i 100 kN m: "
+                  "Aarsnes & Shor's well B); the wave guides carry the same wall law cell by cell.", "", *HEADER,
+                  *compiled_rows(case, GRIDS[:3], args.t_end, args.after),
+                  *reference_rows(case, args.t_end, args.after, CELLS[:2])]
     out = ROOT / "benchmarks" / "results" / "stick_slip_waves.md"
     out.write_text("\n".join(lines) + "\n")
     print(f"-> {out}")
