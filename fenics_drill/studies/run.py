@@ -515,7 +515,7 @@ def discretisation_reasons(scene, summary: dict) -> list[str]:
             f"the nominal step resolves the band's f_max with {band_steps:.3g} steps per period (the default "
             f"{RESOLVING_BAND_STEPS:g}): the efficiency (96) came out 4-7 % high at the paper's 2 on the paper scene "
             "(docs/verification.md); compare with a run at time.dt = -1")
-    elif not scene.time.adaptive:
+    elif not scene.time.adaptive and scene.model.bit_rock:
         summary.setdefault("advice", []).append(
             "a fixed step (time.adaptive = false) does not resolve the bit's start-up: on the paper scene over 0.5 s "
             "rop was 1.8 % and the efficiency 1.0 % off the converged model at the nominal step (docs/performance.md)")
@@ -606,6 +606,13 @@ def quantities_of_run(series_path: Path) -> dict:
                       "the size of a few steps' errors (on a long string, the bit has barely started moving) and "
                       "may be off by several %: run longer, or at a tighter time.error_tolerance "
                       "(docs/verification.md)")
+    transit = p.length / scene.beam.elements / p.torsional_wave_speed  # an element's torsional transit [s]
+    longest = float(np.diff(data["time"]).max(initial=0.0))
+    if scene.contact.static_factor > scene.contact.friction and scene.time.adaptive and longest > transit:
+        advice.append(f"the wall's static friction makes the string break loose in torsional waves, which steps "
+                      f"longer than an element's torsional transit ({1e3 * transit:.3g} ms) smooth away, and this "
+                      f"run's steps reached {1e3 * longest:.3g} ms: run it with time.adaptive = false and time.dt "
+                      f"= {transit:.2g} or less (docs/guide/stick_slip_maps.md)")
     if scene.model.contact and scene.model.lateral_length < 0 and not data["vertices_in_contact"].any():
         advice.append("the string never touched the wall: model.contact = false gives the same answer "
                       "without paying for contact")
