@@ -67,6 +67,20 @@ def point_scene(scene, controller: str, weight_on_bit: float, rotation_speed: fl
     return point
 
 
+def check_weight_axis(scene) -> None:
+    """Refuse a grid of several weights on bit where none reaches the bit: a scene rotating off bottom (no bit law,
+    or a velocity drive that starts off bottom) would give the same point at each, labelled with weights it never
+    felt."""
+    drive = scene.drive
+    pressed = scene.model.bit_rock and (drive.mode == "hook_load" or scene.starts_on_bottom)
+    low, high, count = scene.stick_slip_map.weight_on_bit
+    if not pressed and (count > 1 and high != low):
+        why = "model.bit_rock = false" if not scene.model.bit_rock else "a velocity drive that starts off bottom"
+        raise SceneError(f"stick_slip_map.weight_on_bit = {list(scene.stick_slip_map.weight_on_bit)!r} is not "
+                         f"admissible: the scene rotates off bottom ({why}), so no weight reaches the bit; give it "
+                         "one point, [w, w, 1] (any w > 0, unused), and map the rotation speed")
+
+
 def _point_path(out: Path, index: int) -> Path:
     return out / "points" / f"{index:06d}.json"
 
@@ -104,6 +118,7 @@ def write_stick_slip_map(scene, out: str | Path, resume: bool = False, overwrite
     out = Path(out)
     clock = time.perf_counter()
     scene = map_scene(scene)
+    check_weight_axis(scene)
     points = map_points(scene)
     for controller, w, o in points:  # every point checked before the directory is taken
         point_scene(scene, controller, w, o)

@@ -221,6 +221,16 @@ def test_a_map_that_cannot_be_drawn_is_refused_in_one_line(tmp_path, capsys, set
     assert not out.exists()
 
 
+def test_a_map_of_weights_on_bit_off_bottom_is_refused_in_one_line(tmp_path, capsys):
+    """Rotating off bottom (demos/scenes/off_bottom_well_b.toml: no bit law) no weight reaches the bit: a grid of
+    several weights would repeat one point under labels it never felt."""
+    out = tmp_path / "map"
+    assert main(["stick-slip-map", "demos/scenes/off_bottom_well_b.toml", "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "stick_slip_map.weight_on_bit" in err and "off bottom" in err and len(err.strip().splitlines()) == 1, err
+    assert not out.exists()
+
+
 def test_the_schemes_own_damping_at_the_first_torsional_mode_is_alpha_omega_dt_over_2():
     """A 1000 m pipe turning freely in the hole (no wall, no bit, no damping (38)), its top held at the drive's
     speed, set swinging in its first torsional mode (the quarter wave sin(pi x / 2L)): the decay rate of the bit's
