@@ -185,9 +185,9 @@ def test_a_full_disk_ends_an_mpi_study_in_one_line_per_rank_with_a_failed_summar
     out = small_disk / "mc"
     result = subprocess.run([MPIEXEC, "-n", "2", *TOOL, *MC, "--samples", "40", "--out", str(out)],
                             capture_output=True, text=True, cwd=ROOT, timeout=TIMEOUT)
-    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert result.returncode == 1 and "Traceback" not in result.stderr, result.stderr
     ours = [line for line in result.stderr.splitlines() if line.startswith("fenics-drill")]
-    assert ours and all("no space left on the device" in line for line in ours)
+    assert ours and all("no space left on the device" in line for line in ours), result.stderr
     summary = summary_of(out)
     assert summary["status"] == "failed" and "no space left" in summary["message"]
 
