@@ -36,8 +36,8 @@ from fenics_drill.observables.whirl import whirl
 from fenics_drill.scene import Time
 from fenics_drill.solvers.static import StaticFailure, static_report
 from fenics_drill.model.resolution import band_frequency, mesh_advice
-from fenics_drill.solvers.step_control import (RunFailure, check_run_length, least_steps, nominal_step,
-                                              steps_per_band_period)
+from fenics_drill.solvers.step_control import (RunFailure, breaks_loose_in_waves, check_run_length, least_steps,
+                                              nominal_step, steps_per_band_period, torsional_transit)
 from fenics_drill.solvers.time_loop import Simulation, StepRecord
 from fenics_drill.studies.lifecycle import (StopOnSignal, agree_to_stop, command_output, scene_record, stop_if_requested,
                                             uninterrupted)
@@ -349,10 +349,15 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
             recorder = RunRecorder(model, scene, out, on_write=running)
             u0 = model.bit_state(start.q, start.qd)[0]
             summary["nominal_dt"] = nominal_step(scene)
+            capped = scene.time.dt <= 0 and summary["nominal_dt"] == torsional_transit(scene)
+            if capped:
+                summary["nominal_dt_reason"] = ("an element's torsional transit: the wall's static friction makes the "
+                                                "string break loose in torsional waves")
             if progress:  # the space it runs in and its length before it starts (the progress line's estimate follows)
                 space = "the full order" if model.space.sparse else "a reduced model"
+                why = f" ({summary['nominal_dt_reason']})" if capped else ""
                 sys.stderr.write(f"  {space}, {model.size} unknowns; {scene.time.t_end:g} s at a step of at most "
-                                 f"{summary['nominal_dt']:.3g} s: at least {least_steps(scene):.0f} steps\n")
+                                 f"{summary['nominal_dt']:.3g} s{why}: at least {least_steps(scene):.0f} steps\n")
                 sys.stderr.flush()
             loop_clock = time.perf_counter()
             try:
@@ -606,13 +611,13 @@ def quantities_of_run(series_path: Path) -> dict:
                       "the size of a few steps' errors (on a long string, the bit has barely started moving) and "
                       "may be off by several %: run longer, or at a tighter time.error_tolerance "
                       "(docs/verification.md)")
-    transit = p.length / scene.beam.elements / p.torsional_wave_speed  # an element's torsional transit [s]
+    transit = torsional_transit(scene)
     longest = float(np.diff(data["time"]).max(initial=0.0))
-    if scene.contact.static_factor > scene.contact.friction and scene.time.adaptive and longest > transit:
+    if breaks_loose_in_waves(scene) and longest > transit * (1.0 + 1e-6):  # a time.dt the scene chose
         advice.append(f"the wall's static friction makes the string break loose in torsional waves, which steps "
                       f"longer than an element's torsional transit ({1e3 * transit:.3g} ms) smooth away, and this "
-                      f"run's steps reached {1e3 * longest:.3g} ms: run it with time.adaptive = false and time.dt "
-                      f"= {transit:.2g} or less (docs/guide/stick_slip_maps.md)")
+                      f"run's steps reached {1e3 * longest:.3g} ms: run it with time.dt = {transit:.2g} or less, or "
+                      "-1, whose nominal step is capped there (docs/guide/stick_slip_maps.md)")
     if scene.model.contact and scene.model.lateral_length < 0 and not data["vertices_in_contact"].any():
         advice.append("the string never touched the wall: model.contact = false gives the same answer "
                       "without paying for contact")
