@@ -99,3 +99,27 @@ def test_a_run_whose_chosen_step_outgrows_the_torsional_transit_is_told_to_short
     assert "nominal_dt_reason" not in summary
     advice = " ".join(summary.get("advice", []))
     assert "static friction" in advice and "time.dt = 0.0032 or less" in advice
+
+
+#: Aarsnes & Shor's published off-bottom model on the side-by-side case (demos/scenes/off_bottom_side_by_side.toml),
+#: run by ``python benchmarks/published_off_bottom_model.py --published PATH`` from a checkout of their code, on their
+#: 2.5 m cells, over the whole cycles in [60, 300] s (benchmarks/results/published_off_bottom_model.md): the mean
+#: motor torque [N m], the bit's fastest spin [rad/s] and the motor torque's peak [N m].
+PUBLISHED_SIDE_BY_SIDE = {"surface_torque": 18244.0, "max_spin": 17.86, "peak_torque": 27790.0}
+
+
+def test_the_published_off_bottom_model_side_by_side():
+    """The compiled steps on the case both models state alike, against the authors' published code, on this string's
+    default 10 m elements: the mean motor torque within 0.5 % (measured 0.001 %), the torque's peak within 2 % (0.3 %)
+    and the fastest spin within 3 % (0.8 %).  The oscillation is irregular, and its statistics move with the mesh's
+    dissipation in both models and in the exact characteristics (the benchmark's table): the two torques stay within
+    0.6 % of the published ones on every mesh of all three, the fastest spin within 1.2 % on this string's 5 and 2.5
+    m elements (their own 1.25 m cells give 9 % less); the mean cycle and the stuck share agree on these meshes (6.90
+    against 6.88 s, 0.455 against 0.458) but move by up to 4 s and 0.2 on others, so they are not asserted."""
+    scene = fd.load_scene("demos/scenes/off_bottom_side_by_side.toml")
+    series = start(scene).run(300.0)
+    mine = limit_cycle_statistics(series, scene.drive.rotation_speed, 60.0)
+    peak = series["top_torque"][series["time"] > 60.0].max()
+    assert mine["surface_torque"] == pytest.approx(PUBLISHED_SIDE_BY_SIDE["surface_torque"], rel=0.005)
+    assert mine["max_spin"] == pytest.approx(PUBLISHED_SIDE_BY_SIDE["max_spin"], rel=0.03)
+    assert peak == pytest.approx(PUBLISHED_SIDE_BY_SIDE["peak_torque"], rel=0.02)
