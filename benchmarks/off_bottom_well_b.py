@@ -112,23 +112,34 @@ def main() -> None:
 
 
 def draw(series: dict, after: float, path: Path, omega: float) -> None:
+    t = series["time"]
+    shown = (t > after) & (t < after + SHOWN)
+    spins = {"bit": (t[shown], series["bit_angular_velocity"][shown]),
+             "top drive": (t[shown], series["top_angular_velocity"][shown])}
+    spin_and_torque_figure(spins, {"motor": (t[shown], series["top_torque"][shown])}, omega,
+                           "Well B rotating off bottom at 40 rpm (Aarsnes & Shor 2018), PI top drive, 10 m elements",
+                           path)
+
+
+def spin_and_torque_figure(spins: dict, torques: dict, omega: float, title: str, path: Path) -> None:
+    """Rotation speeds [rpm] over motor torques [kN m]: each a label's (time, value [rad/s or N m]); the set speed
+    ``omega`` [rad/s] dashed."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    t = series["time"]
-    shown = (t > after) & (t < after + SHOWN)
     fig, (spin_axis, torque_axis) = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True)
-    spin_axis.plot(t[shown], series["bit_angular_velocity"][shown] * 30 / math.pi, lw=0.8, label="bit")
-    spin_axis.plot(t[shown], series["top_angular_velocity"][shown] * 30 / math.pi, lw=0.8, label="top drive")
+    for label, (t, spin) in spins.items():
+        spin_axis.plot(t, spin * 30 / math.pi, lw=0.8, label=label)
+    for label, (t, torque) in torques.items():
+        torque_axis.plot(t, torque / 1e3, lw=0.8, label=label)
     spin_axis.axhline(omega * 30 / math.pi, color="k", lw=0.5, ls="--")
     spin_axis.set_ylabel("rotation speed [rpm]")
     spin_axis.legend(loc="upper right")
-    torque_axis.plot(t[shown], series["top_torque"][shown] / 1e3, lw=0.8)
     torque_axis.set_ylabel("motor torque [kN m]")
     torque_axis.set_xlabel("time [s]")
-    spin_axis.set_title("Well B rotating off bottom at 40 rpm (Aarsnes & Shor 2018), PI top drive, 10 m elements")
+    spin_axis.set_title(title)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     print(f"-> {path}")

@@ -41,6 +41,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
+from off_bottom_well_b import spin_and_torque_figure  # noqa: E402
 from speed import processor  # noqa: E402
 from torsional_waves import limit_cycle_statistics, torsional_stick_slip  # noqa: E402
 
@@ -190,26 +191,14 @@ def main() -> None:
 
 
 def draw(shown: dict, after: float, path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, (spin_axis, torque_axis) = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True)
+    spins, torques = {}, {}
     for label, series in shown.items():
         t = series["time"]
         window = (t > after) & (t < after + SHOWN)
-        spin_axis.plot(t[window], series["bit_angular_velocity"][window] * 30 / math.pi, lw=0.8, label=label)
-        torque_axis.plot(t[window], series["top_torque"][window] / 1e3, lw=0.8, label=label)
-    spin_axis.axhline(SET_POINT * 30 / math.pi, color="k", lw=0.5, ls="--")
-    spin_axis.set_ylabel("bit speed [rpm]")
-    spin_axis.legend(loc="upper right")
-    torque_axis.set_ylabel("motor torque [kN m]")
-    torque_axis.set_xlabel("time [s]")
-    spin_axis.set_title("Off bottom at 40 rpm, 2500 m in a straight hole at 60 deg: the published model and this one")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    print(f"-> {path}")
+        spins[label] = (t[window], series["bit_angular_velocity"][window])
+        torques[label] = (t[window], series["top_torque"][window])
+    spin_and_torque_figure(spins, torques, SET_POINT, "Off bottom at 40 rpm, 2500 m in a straight hole at 60 deg: the "
+                           "published model and this one", path)
 
 
 if __name__ == "__main__":
