@@ -41,10 +41,12 @@ class StepTooSmall(RunFailure):
 
 
 def torsional_transit(scene) -> float:
-    """An element's torsional wave transit [s]: the string's length over beam.elements, at the torsional wave speed
-    of the pipe (beam.*)."""
+    """An element's torsional wave transit [s]: the axial-torsional elements' length
+    (``model.axial_torsional_element_length``), or the string's length over beam.elements, at the torsional wave
+    speed of the pipe (beam.*)."""
     p = scene.beam_properties
-    return p.length / scene.beam.elements / p.torsional_wave_speed
+    chosen = scene.axial_torsional_element_length
+    return (chosen if chosen > 0 else p.length / scene.beam.elements) / p.torsional_wave_speed
 
 
 def breaks_loose_in_waves(scene) -> bool:
