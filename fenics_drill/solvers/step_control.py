@@ -25,6 +25,8 @@ moves the efficiency of the whole run (docs/verification.md, "The reduced model 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from fenics_drill.model.resolution import band_frequency
@@ -42,11 +44,14 @@ class StepTooSmall(RunFailure):
 
 def torsional_transit(scene) -> float:
     """An element's torsional wave transit [s]: the axial-torsional elements' length
-    (``model.axial_torsional_element_length``), or the string's length over beam.elements, at the torsional wave
-    speed of the pipe (beam.*)."""
-    p = scene.beam_properties
+    (``model.axial_torsional_element_length``), or the string's length over beam.elements, at the fastest torsional
+    wave speed sqrt(G / rho) of the string's sections (beam.* where a section or the string gives none)."""
+    beam = scene.beam
     chosen = scene.axial_torsional_element_length
-    return (chosen if chosen > 0 else p.length / scene.beam.elements) / p.torsional_wave_speed
+    length = chosen if chosen > 0 else scene.string_length / beam.elements
+    speed = max(math.sqrt(section.get("young_modulus", beam.young_modulus) / (2.0 * (1.0 + beam.poisson_ratio))
+                          / section.get("density", beam.density)) for section in (scene.string.sections or [{}]))
+    return length / speed
 
 
 def breaks_loose_in_waves(scene) -> bool:

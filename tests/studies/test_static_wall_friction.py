@@ -123,3 +123,17 @@ def test_the_published_off_bottom_model_side_by_side():
     assert mine["surface_torque"] == pytest.approx(PUBLISHED_SIDE_BY_SIDE["surface_torque"], rel=0.005)
     assert mine["max_spin"] == pytest.approx(PUBLISHED_SIDE_BY_SIDE["max_spin"], rel=0.03)
     assert peak == pytest.approx(PUBLISHED_SIDE_BY_SIDE["peak_torque"], rel=0.02)
+
+
+def test_the_step_cap_follows_the_axial_torsional_elements():
+    """The nominal step of a run with the wall's static friction is an element's torsional transit h / sqrt(G / rho),
+    G and rho the sections' (E = 158.6 GPa and nu = 0.3: G = 61 GPa): the string's length over beam.elements by
+    default, the axial-torsional elements' length where the scene sets it (to round-off: the same closed form)."""
+    from fenics_drill.solvers.step_control import nominal_step
+
+    scene = fd.load_scene("demos/scenes/off_bottom_side_by_side.toml")
+    speed = (61e9 / 7850.0) ** 0.5
+    assert nominal_step(scene) == pytest.approx(2500.0 / 250 / speed, rel=1e-12)
+    finer = scene.with_changes(model={"axial_torsional_element_length": 5.0})
+    assert nominal_step(finer) == pytest.approx(5.0 / speed, rel=1e-12)
+    assert nominal_step(scene.with_changes(contact={"static_friction": -1.0})) > 3.0 * nominal_step(scene)
