@@ -344,6 +344,8 @@ def cmd_stick_slip_map(args) -> int:
               "windows reported)")
     if report["failed_points"]:
         print("  !: a step's Newton failed there even in halves (map.csv says when); the windows before it reported")
+    for advice in report.get("advice", []):
+        print(f"  advice: {advice}")
     return 0
 
 

@@ -2,6 +2,7 @@
 against the finite-element model's run of the same string, steady rotation against the soft string, the limit cycle
 against itself at half the step, what a map reports and refuses."""
 
+import json
 import math
 
 import numpy as np
@@ -229,6 +230,20 @@ def test_a_map_of_weights_on_bit_off_bottom_is_refused_in_one_line(tmp_path, cap
     err = capsys.readouterr().err
     assert "stick_slip_map.weight_on_bit" in err and "off bottom" in err and len(err.strip().splitlines()) == 1, err
     assert not out.exists()
+
+
+def test_a_map_with_the_walls_static_friction_is_told_its_cycle_moves_with_the_mesh(tmp_path, capsys):
+    """One point of the side-by-side case off bottom (20 s): map.json and the printed table carry the advice that
+    the cycle and the stuck share of a static friction above the kinetic one move with the element length (on that
+    case, stuck 0.46, 0.29 and 0.44 on 10, 5 and 2.5 m elements: benchmarks/results/published_off_bottom_model.md)."""
+    out = tmp_path / "map"
+    assert main(["stick-slip-map", "demos/scenes/off_bottom_side_by_side.toml", "--set",
+                 "stick_slip_map.weight_on_bit=['20 kN', '20 kN', 1]", "--set",
+                 "stick_slip_map.rotation_speed=['40 rpm', '40 rpm', 1]", "--set", "stick_slip_map.time_limit=20",
+                 "--out", str(out), "--quiet"]) == 0
+    advice = json.loads((out / "map.json").read_text())["advice"]
+    assert len(advice) == 1 and "half the elements' 10 m" in advice[0]
+    assert "advice: the wall's static friction" in capsys.readouterr().out
 
 
 def test_the_schemes_own_damping_at_the_first_torsional_mode_is_alpha_omega_dt_over_2():
