@@ -40,15 +40,18 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from speed import processor  # noqa: E402
-from torsional_waves import limit_cycle_statistics  # noqa: E402
+from torsional_waves import axial_torsional_stick_slip, limit_cycle_statistics  # noqa: E402
 
 import fenics_drill as fd  # noqa: E402
+from fenics_drill.model.forces.cutting_bit import HELD_BACKWARD_DAMPING  # noqa: E402
 from fenics_drill.studies.stick_slip import start  # noqa: E402
 
 #: Their MAIN.m's case: the cutting weight per depth, damping per time unit, contact torque arm, contact weight, v0.
 K_A, ETA, BETA, WEAR_FLAT, V0 = 20.0, 0.7, 0.1, 200.0, 2.0
 #: The set spins compared (their first, and their second at the same v0), and the time units run and skipped.
 SPINS, DURATION, AFTER = (1.0, 1.8), 120.0, 60.0
+#: The exact characteristics' torsional cell [m] (the axial one 1.6 times it: 1 m).
+CELL = 0.625
 #: The dimensional string (module doc).
 LENGTH, OUTER, INNER, YOUNG, POISSON, DENSITY = 2000.0, 0.127, 0.1086, 210e9, 0.28, 7850.0
 BLADES, RADIUS, ZETA, FLAT_LENGTH, MU = 4, 0.108, 1.0, 1.2e-3, 0.5
@@ -122,6 +125,21 @@ backward_spin = "held"
         return fd.load_scene(path)
 
 
+def characteristics(scene, duration: float, cell: float) -> dict:
+    """The scene's string and bit law solved exactly along the characteristics of its axial and torsional wave guides
+    (:func:`torsional_waves.axial_torsional_stick_slip`, torsional cells of ``cell`` [m]), its top held moving."""
+    beam, bit, drive = scene.beam, scene.bit_rock, scene.drive
+    shear = beam.young_modulus / (2.0 * (1.0 + beam.poisson_ratio))
+    polar, area = math.pi / 32.0 * (OUTER**4 - INNER**4), math.pi / 4.0 * (OUTER**2 - INNER**2)
+    sections = [(LENGTH, beam.young_modulus * area, beam.density * area, shear * polar, beam.density * polar)]
+    energy, radius = bit.specific_energy, bit.bit_radius
+    law = (bit.blades, bit.cutting_orientation * energy * radius, energy * radius**2 / 2.0,
+           bit.contact_strength * radius * bit.wear_flat_length, bit.friction * bit.geometry_factor * radius / 2.0,
+           bit.contact_velocity, bit.contact_depth, bit.contact_velocity / radius, HELD_BACKWARD_DAMPING)
+    return axial_torsional_stick_slip(sections, drive.rotation_speed, drive.axial_velocity, None, drive.weight_on_bit,
+                                      beam.damping, 0.0, law, duration, cell, max(1, round(10 / cell)))
+
+
 def statistics(t: np.ndarray, velocity: np.ndarray, spin: np.ndarray, omega0: float) -> dict:
     """The limit cycle's statistics over the whole cycles after AFTER, in their units."""
     s = limit_cycle_statistics({"time": t, "bit_angular_velocity": spin, "top_torque": 0.0 * t}, omega0, AFTER)
@@ -152,6 +170,13 @@ def main() -> None:
         mine = statistics(series["time"] / s["time"], series["bit_velocity"] / s["velocity"],
                           series["bit_angular_velocity"] / s["spin"], omega0)
         rows.append(row(f"this string, omega0 = {omega0:g}, {LENGTH / args.elements:g} m elements", mine, wall))
+        print(rows[-1], flush=True)
+        clock = time.perf_counter()
+        exact = characteristics(scene_of(omega0, args.elements), DURATION * s["time"], CELL)
+        wall = time.perf_counter() - clock
+        rows.append(row(f"this string's law, exact characteristics, omega0 = {omega0:g}, {CELL:g} m cells",
+                        statistics(exact["time"] / s["time"], exact["bit_velocity"] / s["velocity"],
+                                   exact["bit_angular_velocity"] / s["spin"], omega0), wall))
         print(rows[-1], flush=True)
     lines = ["# Aarsnes & van de Wouw's published axial-torsional model on bottom, side by side with this string", "",
              f"Command: `python benchmarks/published_axial_torsional_model.py --published-series DIR --elements "

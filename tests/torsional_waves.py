@@ -334,7 +334,10 @@ def _march_coupled(axial_z, torsion_z, weight_source, axial_n0, omega_top, v0, h
             ft[k] -= loss
             gt[k] -= loss
         ga_top, gt_top = ga[0], gt[0]
-        fa_next[0] = ga_top - hook_load / axial_z[0]  # the hook's pull: N(0) = hook load
+        if math.isnan(hook_load):  # the top held moving at V0: v(0) = V0
+            fa_next[0] = v0 - ga_top
+        else:  # the hook's pull: N(0) = hook load
+            fa_next[0] = ga_top - hook_load / axial_z[0]
         ft_next[0] = omega_top - gt_top  # the held top
         for j in range(1, na):
             above, below = axial_z[j - 1], axial_z[j]
@@ -372,12 +375,12 @@ def _march_coupled(axial_z, torsion_z, weight_source, axial_n0, omega_top, v0, h
     return out
 
 
-def axial_torsional_stick_slip(sections, rotation_speed: float, axial_velocity: float, hook_load: float,
+def axial_torsional_stick_slip(sections, rotation_speed: float, axial_velocity: float, hook_load: float | None,
                                weight_on_bit: float, damping: float, gravity: float, law: tuple, duration: float,
                                cell: float = 1.0, stride: int = 10) -> dict:
     """The bit's spin and velocity and the drive's torque over ``duration`` [s], every ``stride`` steps, from the
     string's static state under ``weight_on_bit`` [N] moving at (``axial_velocity``, ``rotation_speed``), its top
-    pulled with ``hook_load`` [N] and turned at the held speed, the bit in the cutting law ``law`` = (n, zeta eps a,
+    pulled with ``hook_load`` [N] (None: held moving at ``axial_velocity``) and turned at the held speed, the bit in the cutting law ``law`` = (n, zeta eps a,
     eps a^2 / 2, sigma a l, mu gamma a / 2, v_c, d_c, v_c / a, the damping c_h that holds a backward spin: the torque
     gains -c_h omega while omega < 0) over a bottom drilled steadily before t = 0.
     ``sections``: (length, E A, rho A, G J, rho I_p) from the top down, one ratio c_A / c_T that makes every length a
@@ -404,7 +407,8 @@ def axial_torsional_stick_slip(sections, rotation_speed: float, axial_velocity: 
         source += [gravity] * cells_a
     feed = axial_velocity / rotation_speed
     rows = _march_coupled(np.array(axial_z), np.array(torsion_z), np.array(source), np.array(static),
-                          rotation_speed, axial_velocity, hook_load, damping, dt, int(round(duration / dt)), stride,
+                          rotation_speed, axial_velocity, math.nan if hook_load is None else hook_load, damping, dt,
+                          int(round(duration / dt)), stride,
                           np.array([*law, feed]))
     return {"time": rows[:, 0], "bit_angular_velocity": rows[:, 1], "top_torque": rows[:, 2],
             "bit_velocity": rows[:, 3]}
