@@ -414,6 +414,16 @@ def axial_torsional_stick_slip(sections, rotation_speed: float, axial_velocity: 
             "bit_velocity": rows[:, 3]}
 
 
+def _cutting_law(bit) -> tuple:
+    """:func:`axial_torsional_stick_slip`'s ``law`` of a scene's ``bit_rock`` section: its bit held against turning
+    backwards by a damper of 1e6 N m s where ``bit_rock.backward_spin = 'held'``."""
+    a = bit.bit_radius
+    return (float(bit.blades), bit.cutting_orientation * bit.specific_energy * a, bit.specific_energy * a * a / 2.0,
+            bit.contact_strength * a * bit.wear_flat_length, bit.friction * bit.geometry_factor * a / 2.0,
+            bit.contact_velocity, bit.contact_depth, bit.contact_velocity / a,
+            1e6 if bit.backward_spin == "held" else 0.0)
+
+
 def vertical_cutting_law_case(elements: int = 200, weight_on_bit: float = 60e3, rotation_speed: float = 4.0 * math.pi,
                               backward_spin: str = "free"):
     """(scene, reference): demos/scenes/vertical_2000m.toml with the cutting law under its hook-load drive, in air, of a
@@ -436,15 +446,111 @@ def vertical_cutting_law_case(elements: int = 200, weight_on_bit: float = 60e3, 
         sections.append((section["length"], beam.young_modulus * area, beam.density * area, shear * polar,
                          beam.density * polar))
         weight += beam.density * area * section["length"] * scene.environment.gravity
-    a = bit.bit_radius
-    law = (float(bit.blades), bit.cutting_orientation * bit.specific_energy * a, bit.specific_energy * a * a / 2.0,
-           bit.contact_strength * a * bit.wear_flat_length, bit.friction * bit.geometry_factor * a / 2.0,
-           bit.contact_velocity, bit.contact_depth, bit.contact_velocity / a, 1e6 if backward_spin == "held" else 0.0)
+    law = _cutting_law(bit)
 
     def reference(duration: float, cell: float = 1.0) -> dict:
         return axial_torsional_stick_slip(sections, rotation_speed, scene.drive.axial_velocity,
                                           weight - weight_on_bit, weight_on_bit, beam.damping,
                                           scene.environment.gravity, law, duration, cell, max(1, round(10 / cell)))
+
+    return scene, reference
+
+
+#: Aarsnes & van de Wouw's published axial-torsional model (github.com/ulfjakob/AxialTorsionalDrillString, "Coupled -
+#: nondim"), the case of its MAIN.m: the cutting weight per depth, damping per time unit, contact torque arm, contact weight, v0.
+K_A, ETA, BETA, WEAR_FLAT, V0 = 20.0, 0.7, 0.1, 200.0, 2.0
+#: The string their case is stated for (:func:`moving_top_cutting_law_case`).
+LENGTH, OUTER, INNER, YOUNG, POISSON, DENSITY = 2000.0, 0.127, 0.1086, 210e9, 0.28, 7850.0
+BLADES, RADIUS, ZETA, FLAT_LENGTH, MU = 4, 0.108, 1.0, 1.2e-3, 0.5
+
+
+def published_scales() -> dict:
+    """The dimensional scales of their nondimensional groups for this string: time L / c_t, velocity U* / t*, spin
+    (2 pi / n) / t*, depth U* = 2 G J (2 pi / n) / (L eps a^2 n) (their cutting torque d), weight E A U* / L, torque
+    G J (2 pi / n) / L, and the specific energy eps their K_a = zeta eps a n L / (E A) asks."""
+    shear = YOUNG / (2.0 * (1.0 + POISSON))
+    speed = math.sqrt(shear / DENSITY)
+    polar = math.pi / 32.0 * (OUTER**4 - INNER**4)
+    area = math.pi / 4.0 * (OUTER**2 - INNER**2)
+    passage = 2.0 * math.pi / BLADES
+    energy = K_A * YOUNG * area / (ZETA * RADIUS * BLADES * LENGTH)  # eps from K_a = zeta eps a n L / (E A)
+    depth = 2.0 * shear * polar * passage / (LENGTH * energy * RADIUS**2 * BLADES)
+    weight, torque = YOUNG * area * depth / LENGTH, shear * polar * passage / LENGTH
+    t_star = LENGTH / speed
+    return {"time": t_star, "velocity": depth / t_star, "spin": passage / t_star, "depth": depth, "weight": weight,
+            "torque": torque, "specific_energy": energy}
+
+
+def moving_top_cutting_law_case(omega0: float, elements: int = 200):
+    """(scene, reference): their case at the set spin ``omega0`` (their units) stated for 2000 m of 5 in pipe without
+    gravity, its top held moving at their v0 and turning at omega0, the cutting law scaled by
+    :func:`published_scales` (zeta = 1, l = 1.2 mm, mu = 0.5, a 4-blade bit of 0.108 m held against turning
+    backwards, as theirs sticks), damped at their -ln(eta) per time unit; and ``reference(duration, cell)``:
+    :func:`axial_torsional_stick_slip` of that string and law, the top held moving."""
+    import tempfile
+    from pathlib import Path
+
+    import fenics_drill as fd
+
+    s = published_scales()
+    contact = WEAR_FLAT * s["weight"]  # sigma a l
+    text = f"""
+[well]
+md = [0.0, {LENGTH}]
+inclination = [0.0, 0.0]
+azimuth = [0.0, 0.0]
+hole_bottom = [{LENGTH}]
+hole_radius = [{RADIUS}]
+hole_cased = [false]
+[[string.sections]]
+name = "drill pipe 5 in"
+length = {LENGTH}
+outer_diameter = {OUTER}
+inner_diameter = {INNER}
+[beam]
+elements = {elements}
+young_modulus = {YOUNG}
+poisson_ratio = {POISSON}
+density = {DENSITY}
+damping = {-math.log(ETA) / s["time"]!r}
+[model]
+gravity = false
+lateral_length = 0.0
+[contact]
+friction = 0.0
+[drive]
+mode = "velocity"
+axial_velocity = {V0 * s["velocity"]!r}
+rotation_speed = {omega0 * s["spin"]!r}
+weight_on_bit = {(K_A * V0 / omega0 + WEAR_FLAT) * s["weight"]!r}
+start = "on_bottom"
+[bit_rock]
+law = "detournay"
+bit_radius = {RADIUS}
+blades = {BLADES}
+specific_energy = {s["specific_energy"]!r}
+cutting_orientation = {ZETA}
+contact_strength = {contact / (RADIUS * FLAT_LENGTH)!r}
+wear_flat_length = {FLAT_LENGTH}
+friction = {MU}
+geometry_factor = {2.0 * BETA * s["torque"] / (RADIUS * s["weight"]) / MU!r}
+contact_velocity = {0.01 * s["velocity"]!r}
+backward_spin = "held"
+"""
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "scene.toml"
+        path.write_text(text)
+        scene = fd.load_scene(path)
+    beam = scene.beam
+    shear = beam.young_modulus / (2.0 * (1.0 + beam.poisson_ratio))
+    polar, area = math.pi / 32.0 * (OUTER**4 - INNER**4), math.pi / 4.0 * (OUTER**2 - INNER**2)
+    sections = [(LENGTH, beam.young_modulus * area, beam.density * area, shear * polar, beam.density * polar)]
+    drive = scene.drive
+
+    def reference(duration: float, cell: float = 1.25) -> dict:
+        return axial_torsional_stick_slip(sections, drive.rotation_speed, drive.axial_velocity, None,
+                                          drive.weight_on_bit, beam.damping, 0.0, _cutting_law(scene.bit_rock),
+                                          duration, cell, max(1, round(10 / cell)))
 
     return scene, reference
 
