@@ -125,9 +125,8 @@ class Contact:
     stick_stiffness: float = _pos("k_t, the tangential spring of a stuck contact (the Coulomb force below mu |F_n|) "
                                   "[N/m]", 1e8)
     culling: bool = key(True, "evaluate the wall law only where a vertex can reach the wall (exact)")
-    static_friction: float = key(-1.0, "the wall's static friction factor where lateral fields are not solved; -1: "
-                                 "contact.friction; above it, a run's nominal step is capped at an element's "
-                                 "torsional transit [-]", lambda x: x == -1 or x >= 0, "-1 or >= 0")
+    static_friction: float = key(-1.0, "the wall's static friction factor (no lateral fields; it caps a run's step); "
+                                 "-1: contact.friction [-]", lambda x: x == -1 or x >= 0, "-1 or >= 0")
     static_slip_speed: float = _nonneg("slip speed below which the static factor holds a sliding contact [m/s]", 0.0)
 
     @property

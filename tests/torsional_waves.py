@@ -457,7 +457,8 @@ def vertical_cutting_law_case(elements: int = 200, weight_on_bit: float = 60e3, 
 
 
 #: Aarsnes & van de Wouw's published axial-torsional model (github.com/ulfjakob/AxialTorsionalDrillString, "Coupled -
-#: nondim"), the case of its MAIN.m: the cutting weight per depth, damping per time unit, contact torque arm, contact weight, v0.
+#: nondim"), the case of its MAIN.m: the cutting weight per depth, damping per time unit, contact torque arm, contact
+#: weight, v0.
 K_A, ETA, BETA, WEAR_FLAT, V0 = 20.0, 0.7, 0.1, 200.0, 2.0
 #: The string their case is stated for (:func:`moving_top_cutting_law_case`).
 LENGTH, OUTER, INNER, YOUNG, POISSON, DENSITY = 2000.0, 0.127, 0.1086, 210e9, 0.28, 7850.0
