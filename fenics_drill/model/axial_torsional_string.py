@@ -112,3 +112,28 @@ def axial_torsional_string(scene) -> AxialTorsionalString:
         wall_arm=np.asarray(contact_radius, float),
         polar_inertia_at_top=polar, torsional_wave_speed_at_top=wave, axial_wave_speed=axial,
         length=float(disc.properties.length))
+
+
+def mesh_viscosity(string: AxialTorsionalString, zeta: float) -> np.ndarray:
+    """The damping band S K S, S = diag(sqrt(zeta h_i / (2 c_i))): a Kelvin-Voigt viscosity zeta h c / 2 on each wave,
+    h_i the element length at dof i (the mean of a vertex's two) and c_i its field's wave speed (the string's
+    fastest axial one, its top section's torsional one).  Its damping ratio at a mode of circular frequency omega is
+    zeta h omega / (4 c): of order zeta at the mesh's shortest waves (omega ~ 2 sqrt(3) c / h), zeta pi h / (8 L) at
+    the first torsional mode of a string of length L held at its top; zeta = 1 is the numerical viscosity of
+    first-order upwinding at a Courant number of 0."""
+    vertices = np.sort(string.x[string.wall_dofs[:, 0]])
+    lengths = np.diff(vertices)
+    k = np.clip(np.searchsorted(vertices, string.x), 0, vertices.size - 1)
+    at_vertex = np.isclose(vertices[k], string.x, rtol=0.0, atol=1e-9 * string.length)
+    before = lengths[np.clip(k - 1, 0, lengths.size - 1)]
+    after = lengths[np.clip(k, 0, lengths.size - 1)]
+    first, last = k == 0, k == vertices.size - 1
+    h = np.where(at_vertex, np.where(first, after, np.where(last, before, 0.5 * (before + after))), before)
+    speed = np.where(string.angle, string.torsional_wave_speed_at_top, string.axial_wave_speed)
+    scale = np.sqrt(zeta * h / (2.0 * speed))
+    w, n = string.half_width, string.size
+    band = np.zeros_like(string.stiffness)
+    for i in range(n):
+        for j in range(max(0, i - w), min(n, i + w + 1)):
+            band[i, j - i + w] = scale[i] * string.stiffness[i, j - i + w] * scale[j]
+    return band

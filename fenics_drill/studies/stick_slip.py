@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fenics_drill.model.axial_torsional_string import AxialTorsionalString, axial_torsional_string
+from fenics_drill.model.axial_torsional_string import AxialTorsionalString, axial_torsional_string, mesh_viscosity
 from fenics_drill.model.forces.cutting_bit import cutting_law_constants
 from fenics_drill.model.top_drive import controller_gains
 from fenics_drill.model.well import hanging_tension
@@ -164,7 +164,10 @@ def start(scene, string: AxialTorsionalString | None = None, dt: float | None = 
     state = (q, v, np.zeros(n), np.zeros(1), np.stack([q[wall[:, 0]], q[wall[:, 1]]], axis=1), held, surface,
              np.array([1.0, 0.0, feed]))
     wall_law = np.array([contact.friction, contact.stick_stiffness, contact.static_factor, contact.static_slip_speed])
-    constants = (mass, string.damping, string.stiffness, w, string.gravity, string.top, string.bit, wall,
+    damping = string.damping
+    if scene.stick_slip_map.mesh_viscosity > 0:
+        damping = damping + mesh_viscosity(string, scene.stick_slip_map.mesh_viscosity)
+    constants = (mass, damping, string.stiffness, w, string.gravity, string.top, string.bit, wall,
                  string.wall_normal, string.wall_arm, wall_law, bit_kind, bit_law)
     drive_state = np.array([float(axial_held), drive.axial_velocity, -hook_load, float(rotation_held),
                             drive.rotation_speed, k_p, k_i, drive.torque_limit, 0.0])

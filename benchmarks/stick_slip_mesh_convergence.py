@@ -1,0 +1,80 @@
+"""The compiled axial-torsional steps' limit cycle against the mesh and the step, with and without the map's mesh
+viscosity: benchmarks/results/stick_slip_mesh_convergence.md.
+
+    python benchmarks/stick_slip_mesh_convergence.py
+
+The case is Aarsnes & van de Wouw's bouncing bit on bottom at omega0 = 1
+(benchmarks/published_axial_torsional_model.py; tests/torsional_waves.py, :func:`moving_top_cutting_law_case`), whose
+bit lifts off and comes back every cycle.  Each row is one run of :func:`~fenics_drill.studies.stick_slip.start` over
+120 of their time units, with ``stick_slip_map.mesh_viscosity`` = zeta, 2000 m / elements long elements and the step
+a share of the default (half the element's axial wave transit); the last row is this string's law solved exactly
+along its characteristics.  Statistics over the whole cycles in [60, 120], their units.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from published_axial_torsional_model import DURATION, statistics  # noqa: E402
+from speed import processor  # noqa: E402
+from torsional_waves import LENGTH, moving_top_cutting_law_case, published_scales  # noqa: E402
+
+from fenics_drill.model.axial_torsional_string import axial_torsional_string  # noqa: E402
+from fenics_drill.studies.stick_slip import default_step, start  # noqa: E402
+
+#: (zeta, elements, share of the default step) of each run.
+RUNS = [(zeta, elements, share) for zeta in (1.0, 0.25, 0.0)
+        for elements, share in ((200, 2.0), (200, 1.0), (200, 0.5), (200, 0.25), (400, 1.0), (1000, 1.0))]
+#: The exact characteristics' torsional cells [m].
+CELLS = (1.25, 0.3125)
+
+
+def main() -> None:
+    s = published_scales()
+    rows = []
+    for zeta, elements, share in RUNS:
+        scene, _ = moving_top_cutting_law_case(1.0, elements)
+        scene = scene.with_changes(stick_slip_map={"mesh_viscosity": zeta})
+        string = axial_torsional_string(scene)
+        simulation = start(scene, string, dt=share * default_step(string))
+        clock = time.perf_counter()
+        series = simulation.run(DURATION * s["time"])
+        wall = time.perf_counter() - clock
+        m = statistics(series["time"] / s["time"], series["bit_velocity"] / s["velocity"],
+                       series["bit_angular_velocity"] / s["spin"], 1.0)
+        rows.append(f"| {zeta:g} | {LENGTH / elements:g} | {share:g} | {m['period']:.3f} | {m['max_spin']:.3f} | "
+                    f"{m['stuck_share']:.3f} | {m['max_velocity']:.2f} | {m['mean_velocity']:.3f} | {wall:.1f} |")
+        print(rows[-1], flush=True)
+    _, exact_run = moving_top_cutting_law_case(1.0, 200)
+    for cell in CELLS:
+        clock = time.perf_counter()
+        exact = exact_run(DURATION * s["time"], cell)
+        wall = time.perf_counter() - clock
+        m = statistics(exact["time"] / s["time"], exact["bit_velocity"] / s["velocity"],
+                       exact["bit_angular_velocity"] / s["spin"], 1.0)
+        rows.append(f"| exact characteristics | {cell:g} | - | {m['period']:.3f} | {m['max_spin']:.3f} | "
+                    f"{m['stuck_share']:.3f} | {m['max_velocity']:.2f} | {m['mean_velocity']:.3f} | {wall:.1f} |")
+        print(rows[-1], flush=True)
+    lines = ["# The bouncing bit's limit cycle against the mesh, the step and the mesh viscosity", "",
+             f"Command: `python benchmarks/stick_slip_mesh_convergence.py`. Machine: {platform.machine()}, "
+             f"{os.cpu_count()} cores ({processor()}), Python {platform.python_version()}; one process. Aarsnes & van "
+             "de Wouw's case at omega0 = 1 (benchmarks/published_axial_torsional_model.py), 120 time units, "
+             "statistics over the whole cycles in [60, 120] in their units. zeta: `stick_slip_map.mesh_viscosity`; "
+             "step: the share of the default step (half the element's axial wave transit).", "",
+             "| zeta | element [m] | step | cycle | fastest spin | stuck share | fastest bit velocity | "
+             "mean bit velocity | wall [s] |", "|---|---|---|---|---|---|---|---|---|", *rows]
+    out = ROOT / "benchmarks" / "results" / "stick_slip_mesh_convergence.md"
+    out.write_text("\n".join(lines) + "\n")
+    print(f"-> {out}")
+
+
+if __name__ == "__main__":
+    main()
