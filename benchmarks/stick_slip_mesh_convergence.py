@@ -1,5 +1,5 @@
 """The compiled axial-torsional steps' limit cycle against the mesh and the step, with and without the map's mesh
-viscosity: benchmarks/results/stick_slip_mesh_convergence.md.
+viscosity, on two cases: benchmarks/results/stick_slip_mesh_convergence.md.
 
     python benchmarks/stick_slip_mesh_convergence.py
 
@@ -9,10 +9,15 @@ time it breaks free (its depth of cut stays above 0).  Each row is one run of :f
 120 of their time units, with ``stick_slip_map.mesh_viscosity`` = zeta, 2000 m / elements long elements and the step
 a share of the default (half the element's axial wave transit); the last row is this string's law solved exactly
 along its characteristics.  Statistics over the whole cycles in [60, 120], their units.
+
+The second case is a calm stick-slip cycle: the 2000 m vertical string drilling with the cutting law at 45 kN and
+100 rpm (tests/torsional_waves.py, :func:`vertical_cutting_law_case`; the test
+``test_the_cutting_laws_limit_cycle_is_the_axial_and_torsional_wave_guides``), over [40, 100] s.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import platform
 import sys
@@ -25,7 +30,8 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from published_axial_torsional_model import DURATION, statistics  # noqa: E402
 from speed import processor  # noqa: E402
-from torsional_waves import LENGTH, moving_top_cutting_law_case, published_scales  # noqa: E402
+from torsional_waves import (LENGTH, limit_cycle_statistics, moving_top_cutting_law_case, published_scales,  # noqa: E402
+                             vertical_cutting_law_case)
 
 from fenics_drill.model.axial_torsional_string import axial_torsional_string  # noqa: E402
 from fenics_drill.studies.stick_slip import default_step, start  # noqa: E402
@@ -35,6 +41,35 @@ RUNS = [(zeta, elements, share) for zeta in (1.0, 0.25, 0.0)
         for elements, share in ((200, 2.0), (200, 1.0), (200, 0.5), (200, 0.25), (400, 1.0), (1000, 1.0))]
 #: The exact characteristics' torsional cells [m].
 CELLS = (1.25, 0.3125)
+#: (zeta, elements, share of the default step) of each run of the calm case, and the exact characteristics' cells.
+CALM_RUNS = [(zeta, elements, share) for zeta in (1.0, 0.25, 0.0) for elements, share in ((200, 1.0), (200, 0.25),
+                                                                                          (400, 1.0))]
+CALM_CELLS = (1.0, 0.5)
+
+
+def calm_rows() -> list[str]:
+    """The calm case's rows: the compiled steps, then the exact characteristics."""
+    rows = []
+    for zeta, elements, share in CALM_RUNS:
+        scene, _ = vertical_cutting_law_case(elements, 45e3, 100.0 * math.pi / 30.0)
+        scene = scene.with_changes(stick_slip_map={"mesh_viscosity": zeta})
+        string = axial_torsional_string(scene)
+        clock = time.perf_counter()
+        m = limit_cycle_statistics(start(scene, string, dt=share * default_step(string)).run(100.0),
+                                   scene.drive.rotation_speed, 40.0)
+        rows.append(f"| {zeta:g} | {string.length / elements:g} | {share:g} | {m['period']:.3f} | "
+                    f"{m['max_spin']:.2f} | {m['min_spin']:.3f} | {m['stuck_share']:.3f} | "
+                    f"{m['surface_torque'] / 1e3:.3f} | {time.perf_counter() - clock:.1f} |")
+        print(rows[-1], flush=True)
+    scene, exact_run = vertical_cutting_law_case(200, 45e3, 100.0 * math.pi / 30.0)
+    for cell in CALM_CELLS:
+        clock = time.perf_counter()
+        m = limit_cycle_statistics(exact_run(100.0, cell), scene.drive.rotation_speed, 40.0)
+        rows.append(f"| exact characteristics | {cell:g} | - | {m['period']:.3f} | {m['max_spin']:.2f} | "
+                    f"{m['min_spin']:.3f} | {m['stuck_share']:.3f} | {m['surface_torque'] / 1e3:.3f} | "
+                    f"{time.perf_counter() - clock:.1f} |")
+        print(rows[-1], flush=True)
+    return rows
 
 
 def main() -> None:
@@ -70,7 +105,11 @@ def main() -> None:
              "statistics over the whole cycles in [60, 120] in their units. zeta: `stick_slip_map.mesh_viscosity`; "
              "step: the share of the default step (half the element's axial wave transit).", "",
              "| zeta | element [m] | step | cycle | fastest spin | stuck share | fastest bit velocity | "
-             "mean bit velocity | wall [s] |", "|---|---|---|---|---|---|---|---|---|", *rows]
+             "mean bit velocity | wall [s] |", "|---|---|---|---|---|---|---|---|---|", *rows, "",
+             "The calm stick-slip cycle: the 2000 m vertical string with the cutting law at 45 kN and 100 rpm, "
+             "statistics over the whole cycles in [40, 100] s, SI units.", "",
+             "| zeta | element [m] | step | cycle [s] | fastest spin [rad/s] | slowest spin [rad/s] | stuck share | "
+             "mean surface torque [kN m] | wall [s] |", "|---|---|---|---|---|---|---|---|---|", *calm_rows()]
     out = ROOT / "benchmarks" / "results" / "stick_slip_mesh_convergence.md"
     out.write_text("\n".join(lines) + "\n")
     print(f"-> {out}")
