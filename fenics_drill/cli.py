@@ -335,15 +335,19 @@ def cmd_stick_slip_map(args) -> int:
         at = grid.sel(controller=controller)
         print(f"  {controller}: stick-slip severity by weight on bit (rows, kN) and rotation speed (columns, rpm)")
         print("           " + "".join(f"{o * 30 / np.pi:8.0f}" for o in at.rotation_speed.values))
+        moved = at.step_moved.values if "step_moved" in at else np.zeros(at.settled.shape, bool)
         for i, w in enumerate(at.weight_on_bit.values):
-            cells = [("   fail " if not np.isfinite(v) else f"{v:7.2f}" + ("!" if f else "*" if not s else " "))
-                     for v, s, f in zip(at.severity.values[i], at.settled.values[i], at.failed.values[i])]
+            cells = [("   fail " if not np.isfinite(v) else f"{v:7.2f}" + ("!" if f else "*" if not s else "~" if m
+                                                                          else " "))
+                     for v, s, f, m in zip(at.severity.values[i], at.settled.values[i], at.failed.values[i], moved[i])]
             print(f"  {w / 1e3:8.1f} " + "".join(cells))
     if report["settled_points"] < report["points"]:
         print(f"  *: not settled within stick_slip_map.time_limit = {grid.attrs['time_limit_s']:g} s (its last "
               "windows reported)")
     if report["failed_points"]:
         print("  !: a step's Newton failed there even in halves (map.csv says when); the windows before it reported")
+    if report.get("step_moved_points"):
+        print("  ~: settled, but its cycle moved at half the step (map.csv's step_moved; unsettled points may have too)")
     for advice in report.get("advice", []):
         print(f"  advice: {advice}")
     return 0

@@ -593,6 +593,7 @@ class StickSlipMap:
                                  "fields') [m]", AXIAL_TORSIONAL_ELEMENT_LENGTH)
     mesh_viscosity: float = _nonneg("zeta of a viscosity zeta h c / 2 on both waves, damping the mesh's shortest "
                                     "(1: upwind) [-]", 0.0)
+    step_check: bool = key(False, "also run each point at half its step and flag a cycle that moves (3 times the cost)")
 
 
 @dataclass(frozen=True)

@@ -30,6 +30,16 @@ REPORTED = {"severity": "-", "period_s": "s", "stuck_share": "-", "max_bit_spin_
             "min_bit_spin_rad_s": "rad/s", "mean_bit_spin_rad_s": "rad/s", "rop_m_s": "m/s",
             "surface_torque_N_m": "N m", "hook_load_N": "N", "weight_on_bit_N": "N", "bit_torque_N_m": "N m",
             "mechanical_specific_energy_Pa": "Pa", "time_s": "s", "wall_time_s": "s"}
+#: What a point checked at half its step (``stick_slip_map.step_check``) reports of that run, as ``half_step_<name>``.
+HALF_STEP = {"severity": "-", "period_s": "s", "stuck_share": "-", "max_bit_spin_rad_s": "rad/s",
+             "min_bit_spin_rad_s": "rad/s"}
+
+
+def reported(scene) -> dict:
+    """Each reported quantity's unit: REPORTED, and the half step's with ``stick_slip_map.step_check``."""
+    if not scene.stick_slip_map.step_check:
+        return REPORTED
+    return {**REPORTED, **{f"half_step_{name}": unit for name, unit in HALF_STEP.items()}}
 
 
 def grid(axis: tuple) -> np.ndarray:
@@ -92,18 +102,47 @@ def _read_point(path: Path) -> dict:
     return data
 
 
-def run_point(scene, string, controller: str, weight_on_bit: float, rotation_speed: float) -> dict:
-    """One point's cycle (:func:`~fenics_drill.studies.stick_slip.limit_cycle`), with its wall time; a point whose
-    Newton fails reports it (``failed``), with the metrics of the windows before (NaN in its first), rather than
-    ending the map."""
-    clock = time.perf_counter()
-    point = point_scene(scene, controller, weight_on_bit, rotation_speed)
+def _cycle(point, string, dt: float | None = None) -> dict:
+    """The point's cycle at the step ``dt`` (None: its default); a Newton that fails in the first window reports it
+    (``failed``) with NaN metrics."""
     try:
-        simulation = start(point, string=pressed_for(string, point))
-        out = limit_cycle(point, point.stick_slip_map.time_limit, simulation=simulation)
+        simulation = start(point, string=pressed_for(string, point), dt=dt)
+        return limit_cycle(point, point.stick_slip_map.time_limit, simulation=simulation)
     except StepFailed as err:  # in the first window
         out = {name: float("nan") for name in REPORTED}
         out.update(settled=False, steady_rotation=False, failed=str(err))
+        return out
+
+
+#: A cycle has moved at half the step when its period or stuck share, or its fastest or slowest spin (against the
+#: drive's speed), changed by more than the settled cycle's own tolerances (studies/stick_slip.py, settled_cycle).
+MOVED_PERIOD, MOVED_SPIN, MOVED_STUCK = 0.03, 0.03, 0.03
+
+
+def step_moved(cycle: dict, half_step: dict, rotation_speed: float) -> bool:
+    """Whether the cycle at half the step differs from ``cycle`` by more than MOVED_*; a failed or NaN run, or steady
+    rotation at one step and a cycle at the other, counts as moved."""
+    if cycle.get("failed") or half_step.get("failed") or cycle["steady_rotation"] != half_step["steady_rotation"]:
+        return True
+    spins = [abs(half_step[k] - cycle[k]) / rotation_speed for k in ("max_bit_spin_rad_s", "min_bit_spin_rad_s")]
+    moved = not (max(spins) <= MOVED_SPIN and abs(half_step["stuck_share"] - cycle["stuck_share"]) <= MOVED_STUCK)
+    if not cycle["steady_rotation"] and cycle["period_s"] is not None and half_step["period_s"] is not None:
+        moved = moved or not abs(half_step["period_s"] / cycle["period_s"] - 1.0) <= MOVED_PERIOD
+    return moved
+
+
+def run_point(scene, string, controller: str, weight_on_bit: float, rotation_speed: float) -> dict:
+    """One point's cycle (:func:`~fenics_drill.studies.stick_slip.limit_cycle`), with its wall time; a point whose
+    Newton fails reports it (``failed``), with the metrics of the windows before (NaN in its first), rather than
+    ending the map.  With ``stick_slip_map.step_check`` the point is run again at half its step: the half step's
+    period, fastest spin and stuck share, and ``step_moved`` (:func:`step_moved`)."""
+    clock = time.perf_counter()
+    point = point_scene(scene, controller, weight_on_bit, rotation_speed)
+    out = _cycle(point, string)
+    if scene.stick_slip_map.step_check:
+        half = _cycle(point, string, 0.5 * out["dt_s"]) if "dt_s" in out else {"failed": out["failed"]}
+        out.update({f"half_step_{name}": half.get(name) for name in HALF_STEP},
+                   step_moved=step_moved(out, half, rotation_speed))
     out["wall_time_s"] = time.perf_counter() - clock
     return out
 
@@ -149,7 +188,7 @@ def write_stick_slip_map(scene, out: str | Path, resume: bool = False, overwrite
         results = [_read_point(_point_path(out, i)) for i in range(len(points))]
         study = _assembled(scene, results, time.perf_counter() - clock, comm.size)
         write_atomic(out / "map.nc", lambda tmp: study["map"].to_netcdf(tmp, engine="h5netcdf"))
-        write_atomic(out / "map.csv", lambda tmp: Path(tmp).write_text(_csv(points, results)))
+        write_atomic(out / "map.csv", lambda tmp: Path(tmp).write_text(_csv(scene, points, results)))
         write_json(out / "map.json", study["report"])
         write_json(out / "summary.json", {"command": "stick-slip-map", "status": "finished", "message": "map.json",
                                           "points": len(points), "wall_time_s": time.perf_counter() - clock,
@@ -157,15 +196,18 @@ def write_stick_slip_map(scene, out: str | Path, resume: bool = False, overwrite
     return study
 
 
-def _csv(points, results) -> str:
+def _csv(scene, points, results) -> str:
+    units = reported(scene)
+    checked = scene.stick_slip_map.step_check
     header = ["controller", "weight_on_bit (N)", "rotation_speed (rad/s)", "settled", "steady_rotation"] + \
-        [f"{name} ({unit})" for name, unit in REPORTED.items()] + ["failed"]
+        [f"{name} ({unit})" for name, unit in units.items()] + (["step_moved"] if checked else []) + ["failed"]
     lines = [",".join(header)]
     for (controller, w, o), r in zip(points, results):
-        values = [r.get(name) for name in REPORTED]
+        values = [r.get(name) for name in units]
         failed = (r.get("failed") or "").replace(",", ";")
         lines.append(",".join([controller, f"{w:.9g}", f"{o:.9g}", str(r["settled"]), str(r["steady_rotation"])]
-                              + ["" if v is None else f"{v:.9g}" for v in values] + [f'"{failed}"' if failed else ""]))
+                              + ["" if v is None else f"{v:.9g}" for v in values]
+                              + ([str(r["step_moved"])] if checked else []) + [f'"{failed}"' if failed else ""]))
     return "\n".join(lines) + "\n"
 
 
@@ -181,8 +223,10 @@ def _assembled(scene, results: list[dict], seconds: float, ranks: int) -> dict:
         return np.array(values, dtype=float).reshape(shape)
 
     dims = ("controller", "weight_on_bit", "rotation_speed")
-    data = {name: (dims, field(name), {"units": unit}) for name, unit in REPORTED.items()}
+    data = {name: (dims, field(name), {"units": unit}) for name, unit in reported(scene).items()}
     data["settled"] = (dims, field("settled").astype(bool))
+    if m.step_check:
+        data["step_moved"] = (dims, field("step_moved").astype(bool))
     data["failed"] = (dims, np.array([bool(r.get("failed")) for r in results]).reshape(shape))
     data["steady_rotation"] = (dims, field("steady_rotation").astype(bool))
     dataset = xr.Dataset(data, coords={"controller": list(m.controllers),
@@ -197,8 +241,15 @@ def _assembled(scene, results: list[dict], seconds: float, ranks: int) -> dict:
               "controllers": {c: {"stick_slip_points": int(np.sum(field("stuck_share")[k] > 0.0)),
                                   "steady_points": int(np.sum(field("steady_rotation")[k] > 0.5))}
                               for k, c in enumerate(m.controllers)}}
+    advice = []
     if scene.contact.static_factor > scene.contact.friction:
-        report["advice"] = [STATIC_FRICTION_ADVICE.format(length=m.element_length)]
+        advice.append(STATIC_FRICTION_ADVICE.format(length=m.element_length))
+    if m.step_check:
+        report["step_moved_points"] = [i for i, r in enumerate(results) if r["step_moved"]]
+        if report["step_moved_points"]:
+            advice.append(STEP_MOVED_ADVICE.format(count=len(report["step_moved_points"])))
+    if advice:
+        report["advice"] = advice
     return {"report": report, "map": dataset}
 
 
@@ -209,3 +260,10 @@ STATIC_FRICTION_ADVICE = (
     "Aarsnes & Shor's case side by side, the stuck share read 0.46, 0.29 and 0.44 on 10, 5 and 2.5 m elements, while "
     "the mean and peak torque held within 0.6 % and the fastest spin within 1.2 %; check a point at half the "
     "elements' {length:g} m (stick_slip_map.element_length) before reading its cycle and stuck share")
+
+#: What a map whose points' cycles moved at half their step is told (docs/guide/stick_slip_maps.md, "The mesh
+#: viscosity").
+STEP_MOVED_ADVICE = (
+    "{count} point(s) moved at half their step (map.csv's step_moved): their cycle is not yet the scheme's answer; "
+    "compare them with stick_slip_map.mesh_viscosity = 1, whose cycles held at half the step where measured and whose "
+    "peaks and stuck share are lower bounds (the stick-slip guide, 'The mesh viscosity')")

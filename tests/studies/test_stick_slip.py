@@ -16,6 +16,7 @@ import fenics_drill as fd
 from fenics_drill.cli import main
 from fenics_drill.solvers.axial_torsional_step import band_product, band_solve
 from fenics_drill.studies.stick_slip import cycle_metrics, limit_cycle, start
+from fenics_drill.studies.stick_slip_map import map_scene, point_scene
 
 BUILD_HOLD = "demos/scenes/well_build_hold.toml"
 
@@ -207,6 +208,31 @@ def test_a_map_writes_its_table_and_figure(tmp_path, capsys):
     assert (out / "map.csv").read_text().splitlines()[0].startswith("controller,weight_on_bit (N),rotation_speed")
     assert (out / "stick_slip_map.png").exists()
     assert "stick-slip severity" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("zeta, moved", [(0.0, True), (1.0, False)])
+def test_a_maps_step_check_reports_the_half_step_and_flags_a_cycle_that_moved(tmp_path, capsys, zeta, moved):
+    """The build-and-hold well's map point at 20 kN and 180 rpm (the settings of ``make well-maps``) with
+    ``stick_slip_map.step_check``: map.nc's half-step fastest spin is a run of the point at half its step
+    (:func:`limit_cycle`, to 1e-12: the same steps), and ``step_moved`` says whether its fastest spin moved by more
+    than 3 % of the drive's speed.  Without the mesh viscosity it moved (measured 36.23 and 37.50 rad/s, 6.7 % of
+    18.85 rad/s; benchmarks/results/stick_slip_step_check.md), with ζ = 1 it held (31.42 and 31.43 rad/s)."""
+    out = tmp_path / "map"
+    settings = ["drive.mode='hook_load'", "bit_rock.law='detournay'", "bit_rock.bit_radius='4.25 in'",
+                "stick_slip_map.weight_on_bit=['20 kN', '20 kN', 1]",
+                "stick_slip_map.rotation_speed=['180 rpm', '180 rpm', 1]", "stick_slip_map.step_check=true",
+                f"stick_slip_map.mesh_viscosity={zeta}"]
+    assert main(["stick-slip-map", BUILD_HOLD, *[a for setting in settings for a in ("--set", setting)],
+                 "--out", str(out), "--quiet"]) == 0
+    grid = xarray.load_dataset(out / "map.nc", engine="h5netcdf")
+    point = point_scene(map_scene(fd.load_scene(BUILD_HOLD, settings)), "stiff", 20e3, 6.0 * math.pi)
+    half = limit_cycle(point, point.stick_slip_map.time_limit, dt=0.5 * start(point).dt)
+    assert float(grid["half_step_max_bit_spin_rad_s"].values.ravel()[0]) == pytest.approx(half["max_bit_spin_rad_s"],
+                                                                                         rel=1e-12)
+    assert bool(grid["step_moved"].values.ravel()[0]) is moved
+    advice = json.loads((out / "map.json").read_text()).get("advice", [])
+    assert any("moved at half their step" in a for a in advice) is moved
+    assert ("~: settled, but its cycle moved" in capsys.readouterr().out) is moved
 
 
 @pytest.mark.parametrize("setting, words", [
