@@ -51,13 +51,16 @@ def stick_slip_map_figure(grid, path: Path) -> Path:
                                  shading="flat", vmin=limits[name][0], vmax=limits[name][1])
             fig.colorbar(mesh, ax=ax)
             failed = at["failed"].values if "failed" in at else np.zeros_like(unsettled)
-            for i, j in zip(*np.nonzero(unsettled)):
-                ax.text(rpm[j], weight[i], "!" if failed[i, j] else "x", ha="center", va="center", color="grey")
+            moved = at["step_moved"].values if "step_moved" in at else np.zeros_like(unsettled)
+            for i, j in zip(*np.nonzero(unsettled | moved)):
+                mark = "!" if failed[i, j] else "x" if unsettled[i, j] else "~"
+                ax.text(rpm[j], weight[i], mark, ha="center", va="center", color="grey")
             ax.set_xlabel("rotation speed [rpm]")
             ax.set_ylabel("weight on bit [kN]")
             ax.set_title(f"{controller}: {title}" if col == 0 else title, fontsize=9)
     fig.suptitle(f"stick-slip map ({grid.attrs.get('bit_rock_law', '')} bit law, {grid.attrs.get('drive_mode', '')} "
                  f"drive; x: not settled within {grid.attrs.get('time_limit_s', 0):g} s; !: a step failed, the "
-                 "windows before it shown)", fontsize=10)
+                 "windows before it shown" + ("; ~: moved at half the step" if "step_moved" in grid else "") + ")",
+                 fontsize=10)
     fig.tight_layout()
     return save_figure(fig, path)
