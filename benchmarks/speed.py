@@ -81,6 +81,11 @@ def processor() -> str:
     return platform.processor() or "CPU not reported"
 
 
+def machine() -> str:
+    """This machine as a results file states it: architecture, cores, CPU and Python."""
+    return (f"{platform.machine()}, {os.cpu_count()} cores ({processor()}), Python {platform.python_version()}")
+
+
 def run(scene: Path, settings: tuple, t_end: float, tolerance: float | None = None) -> dict:
     """One `fenics-drill run` in its own process: its summary, the whole run's wall time and its peak memory."""
     with tempfile.TemporaryDirectory() as out:

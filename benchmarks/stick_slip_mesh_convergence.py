@@ -18,8 +18,6 @@ The second case is a calm stick-slip cycle: the 2000 m vertical string drilling 
 from __future__ import annotations
 
 import math
-import os
-import platform
 import sys
 import time
 from pathlib import Path
@@ -29,7 +27,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from published_axial_torsional_model import DURATION, statistics  # noqa: E402
-from speed import processor  # noqa: E402
+from speed import machine  # noqa: E402
 from torsional_waves import (LENGTH, limit_cycle_statistics, moving_top_cutting_law_case, published_scales,  # noqa: E402
                              vertical_cutting_law_case)
 
@@ -72,6 +70,17 @@ def calm_rows() -> list[str]:
     return rows
 
 
+def violent_row(label: str, series: dict, wall: float) -> str:
+    """A row of the violent case's table (their units), printed as it is made."""
+    s = published_scales()
+    m = statistics(series["time"] / s["time"], series["bit_velocity"] / s["velocity"],
+                   series["bit_angular_velocity"] / s["spin"], 1.0)
+    row = (f"| {label} | {m['period']:.3f} | {m['max_spin']:.3f} | {m['stuck_share']:.3f} | {m['max_velocity']:.2f} "
+           f"| {m['mean_velocity']:.3f} | {wall:.1f} |")
+    print(row, flush=True)
+    return row
+
+
 def main() -> None:
     s = published_scales()
     rows = []
@@ -83,24 +92,15 @@ def main() -> None:
         clock = time.perf_counter()
         series = simulation.run(DURATION * s["time"])
         wall = time.perf_counter() - clock
-        m = statistics(series["time"] / s["time"], series["bit_velocity"] / s["velocity"],
-                       series["bit_angular_velocity"] / s["spin"], 1.0)
-        rows.append(f"| {zeta:g} | {LENGTH / elements:g} | {share:g} | {m['period']:.3f} | {m['max_spin']:.3f} | "
-                    f"{m['stuck_share']:.3f} | {m['max_velocity']:.2f} | {m['mean_velocity']:.3f} | {wall:.1f} |")
-        print(rows[-1], flush=True)
+        rows.append(violent_row(f"{zeta:g} | {LENGTH / elements:g} | {share:g}", series, wall))
     _, exact_run = moving_top_cutting_law_case(1.0, 200)
     for cell in CELLS:
         clock = time.perf_counter()
         exact = exact_run(DURATION * s["time"], cell)
-        wall = time.perf_counter() - clock
-        m = statistics(exact["time"] / s["time"], exact["bit_velocity"] / s["velocity"],
-                       exact["bit_angular_velocity"] / s["spin"], 1.0)
-        rows.append(f"| exact characteristics | {cell:g} | - | {m['period']:.3f} | {m['max_spin']:.3f} | "
-                    f"{m['stuck_share']:.3f} | {m['max_velocity']:.2f} | {m['mean_velocity']:.3f} | {wall:.1f} |")
-        print(rows[-1], flush=True)
+        rows.append(violent_row(f"exact characteristics | {cell:g} | -", exact, time.perf_counter() - clock))
     lines = ["# The violent bit's limit cycle against the mesh, the step and the mesh viscosity", "",
-             f"Command: `python benchmarks/stick_slip_mesh_convergence.py`. Machine: {platform.machine()}, "
-             f"{os.cpu_count()} cores ({processor()}), Python {platform.python_version()}; one process. Aarsnes & van "
+             f"Command: `python benchmarks/stick_slip_mesh_convergence.py`. Machine: {machine()}; one process. "
+             "Aarsnes & van "
              "de Wouw's case at omega0 = 1 (benchmarks/published_axial_torsional_model.py), 120 time units, "
              "statistics over the whole cycles in [60, 120] in their units. zeta: `stick_slip_map.mesh_viscosity`; "
              "step: the share of the default step (half the element's axial wave transit).", "",

@@ -10,8 +10,6 @@ The map's settings of ``make well-maps`` (the cutting law, the drawworks holding
 from __future__ import annotations
 
 import math
-import os
-import platform
 import sys
 import time
 from pathlib import Path
@@ -19,7 +17,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from speed import processor  # noqa: E402
+from speed import machine  # noqa: E402
 
 import fenics_drill as fd  # noqa: E402
 from fenics_drill.model.axial_torsional_string import axial_torsional_string, pressed_for  # noqa: E402
@@ -51,8 +49,8 @@ def main() -> None:
                             f"{c['surface_torque_N_m'] / 1e3:.3f} | {time.perf_counter() - clock:.1f} |")
                 print(rows[-1], flush=True)
     lines = ["# Points of the build-and-hold well's map at the default step and at half of it", "",
-             f"Command: `python benchmarks/stick_slip_step_check.py`. Machine: {platform.machine()}, {os.cpu_count()} "
-             f"cores ({processor()}), Python {platform.python_version()}; one process. {SCENE} with the settings of "
+             f"Command: `python benchmarks/stick_slip_step_check.py`. Machine: {machine()}; one process. {SCENE} "
+             "with the settings of "
              "`make well-maps`, the stiff drive, 10 m elements; each point to its limit cycle or 200 s. zeta: "
              "`stick_slip_map.mesh_viscosity`; step: the share of the default step.", "",
              "| zeta | weight on bit [kN] | rotation speed [rpm] | step | settled | cycle [s] | fastest spin [rad/s] | "
