@@ -247,7 +247,8 @@ def _assembled(scene, results: list[dict], seconds: float, ranks: int) -> dict:
     if m.step_check:
         report["step_moved_points"] = [i for i, r in enumerate(results) if r["step_moved"]]
         if report["step_moved_points"]:
-            advice.append(STEP_MOVED_ADVICE.format(count=len(report["step_moved_points"])))
+            advice.append((STEP_MOVED_ADVICE if m.mesh_viscosity == 0 else STEP_MOVED_VISCOUS_ADVICE).format(
+                count=len(report["step_moved_points"])))
     if advice:
         report["advice"] = advice
     return {"report": report, "map": dataset}
@@ -267,3 +268,6 @@ STEP_MOVED_ADVICE = (
     "{count} point(s) moved at half their step (map.csv's step_moved): their cycle is not yet the scheme's answer; "
     "compare them with stick_slip_map.mesh_viscosity = 1, whose cycles held at half the step where measured and whose "
     "peaks and stuck share are lower bounds (the stick-slip guide, 'The mesh viscosity')")
+STEP_MOVED_VISCOUS_ADVICE = (
+    "{count} point(s) moved at half their step (map.csv's step_moved) even with the mesh viscosity: their cycle is "
+    "irregular or not resolved at this step; check them with a shorter time.dt before reading their cycle")
