@@ -591,8 +591,8 @@ class StickSlipMap:
     time_limit: float = _pos("longest drilling time run at a point before its cycle has settled [s]", 200.0)
     element_length: float = _pos("the axial-torsional string's element length (beam.elements is the lateral "
                                  "fields') [m]", AXIAL_TORSIONAL_ELEMENT_LENGTH)
-    mesh_viscosity: float = _nonneg("zeta of a viscosity zeta h c / 2 on both waves, damping the mesh's shortest "
-                                    "(1: upwind) [-]", 0.0)
+    mesh_viscosity: float = _nonneg("zeta of a viscosity zeta h c / 2 on the torsional wave, damping the mesh's "
+                                    "shortest (1: upwind) [-]", 0.0)
     step_check: bool = key(False, "also run each point at half its step and flag a cycle that moves (3 times the cost)")
 
 

@@ -114,13 +114,15 @@ def axial_torsional_string(scene) -> AxialTorsionalString:
         length=float(disc.properties.length))
 
 
-def mesh_viscosity(string: AxialTorsionalString, zeta: float) -> np.ndarray:
-    """The damping band S K S, S = diag(sqrt(zeta h_i / (2 c_i))): a Kelvin-Voigt viscosity zeta h c / 2 on each wave,
-    h_i the element length at dof i (the mean of a vertex's two) and c_i its field's wave speed (the string's
-    fastest axial one, its top section's torsional one).  Its damping ratio at a mode of circular frequency omega is
-    zeta h omega / (4 c): of order zeta at the mesh's shortest waves (omega ~ 2 sqrt(3) c / h), zeta pi h / (8 L) at
-    the first torsional mode of a string of length L held at its top; zeta = 1 is the numerical viscosity of
-    first-order upwinding at a Courant number of 0."""
+def mesh_viscosity(string: AxialTorsionalString, zeta: float, axial: bool = False) -> np.ndarray:
+    """The damping band S K S, S = diag(sqrt(zeta h_i / (2 c))) on theta_x and 0 on u: a Kelvin-Voigt viscosity
+    zeta h c / 2 on the torsional wave alone, h_i the element length at dof i (the mean of a vertex's two) and c the
+    top section's torsional wave speed (``axial``: on the axial wave too, at the fastest section's axial speed, which
+    benchmarks/stick_slip_mesh_convergence.py measures).  Its damping ratio at a torsional mode of circular frequency
+    omega is zeta h omega / (4 c): of order zeta at the mesh's shortest waves (omega ~ 2 c / h), zeta pi h / (8 L) at the first
+    torsional mode of a string of length L held at its top; zeta = 1 is the numerical viscosity of first-order
+    upwinding at a Courant number of 0.  The axial wave is left sharp: smoothing it removes the bit's stick on a calm
+    cycle the exact model sticks on (docs/guide/stick_slip_maps.md)."""
     vertices = np.sort(string.x[string.wall_dofs[:, 0]])
     lengths = np.diff(vertices)
     k = np.clip(np.searchsorted(vertices, string.x), 0, vertices.size - 1)
@@ -130,7 +132,7 @@ def mesh_viscosity(string: AxialTorsionalString, zeta: float) -> np.ndarray:
     first, last = k == 0, k == vertices.size - 1
     h = np.where(at_vertex, np.where(first, after, np.where(last, before, 0.5 * (before + after))), before)
     speed = np.where(string.angle, string.torsional_wave_speed_at_top, string.axial_wave_speed)
-    scale = np.sqrt(zeta * h / (2.0 * speed))
+    scale = np.where(string.angle | axial, np.sqrt(zeta * h / (2.0 * speed)), 0.0)
     w, n = string.half_width, string.size
     band = np.zeros_like(string.stiffness)
     for i in range(n):

@@ -267,7 +267,8 @@ STATIC_FRICTION_ADVICE = (
 STEP_MOVED_ADVICE = (
     "{count} point(s) moved at half their step (map.csv's step_moved): their cycle is not yet the scheme's answer; "
     "check them with a shorter time.dt. stick_slip_map.mesh_viscosity = 1 holds such a cycle with the step but damps "
-    "stick-slip itself (on the VBH well's map it left no point sticking): the stick-slip guide, 'The mesh viscosity'")
+    "a marginal stick-slip away (on the VBH well's map it left none in the first torsional mode's cycle): the "
+    "stick-slip guide, 'The mesh viscosity'")
 STEP_MOVED_VISCOUS_ADVICE = (
     "{count} point(s) moved at half their step (map.csv's step_moved) even with the mesh viscosity: their cycle is "
     "irregular or not resolved at this step; check them with a shorter time.dt before reading their cycle")

@@ -1,0 +1,112 @@
+"""How much damping the VBH well's stick-slip survives: benchmarks/results/stick_slip_margin.md.
+
+    python benchmarks/stick_slip_margin.py
+
+One point of the VBH well's map (demos/scenes/well_vbh.toml with the settings of ``make well-maps``, the stiff drive,
+20 kN and 120 rpm) run to its limit cycle or 200 s by :func:`~fenics_drill.studies.stick_slip.limit_cycle`: at the
+default step and at half of it, on 10 m and 5 m elements, and with ``stick_slip_map.mesh_viscosity`` = zeta, whose
+damping ratio at the first torsional mode is zeta pi h / (8 L).  Then the string is stepped 120 s with one zeta and
+150 s more from that state with the other, both ways: whether the cycle each zeta reaches depends on where it
+starts (two attractors) or not (the steady rotation's stability changes).  The string's own damping (38) at its
+first torsional mode, held at the top and free at the bit, is stated for scale.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy.linalg import eigh
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from speed import machine  # noqa: E402
+
+import fenics_drill as fd  # noqa: E402
+from fenics_drill.model.axial_torsional_string import axial_torsional_string, pressed_for  # noqa: E402
+from fenics_drill.studies.stick_slip import limit_cycle, start  # noqa: E402
+from fenics_drill.studies.stick_slip_map import map_scene, point_scene  # noqa: E402
+
+SCENE = "demos/scenes/well_vbh.toml"
+SETTINGS = ["drive.mode='hook_load'", "bit_rock.law='detournay'", "bit_rock.bit_radius='4.25 in'"]
+WEIGHT, RPM = 20e3, 120.0
+#: (zeta, element length [m], share of the default step) of each run to the limit cycle.
+RUNS = ((0.0, 10.0, 1.0), (0.0, 10.0, 0.5), (0.0, 5.0, 1.0), (0.25, 10.0, 1.0), (1.0, 10.0, 1.0))
+#: Spin below which the bit counts as stuck in the switched runs [rad/s] (the map's own threshold is its cycle's).
+STUCK_SPIN = 0.1
+
+
+def point(zeta: float, element_length: float = 10.0):
+    scene = map_scene(fd.load_scene(ROOT / SCENE, [*SETTINGS, f"stick_slip_map.mesh_viscosity={zeta}",
+                                                   f"stick_slip_map.element_length={element_length}"]))
+    at = point_scene(scene, "stiff", WEIGHT, RPM * math.pi / 30.0)
+    return at, pressed_for(axial_torsional_string(scene), at)
+
+
+def first_torsional_damping_ratio(string) -> tuple[float, float]:
+    """(omega_1 [rad/s], the damping ratio of (38) there): the torsional block held at the top, free at the bit."""
+    kept = np.flatnonzero(string.angle)
+    kept = kept[kept != string.top[1]]
+    block = np.ix_(kept, kept)
+    mass, damping = string.dense(string.mass)[block], string.dense(string.damping)[block]
+    values, vectors = eigh(string.dense(string.stiffness)[block], mass, subset_by_index=(0, 0))
+    mode, omega = vectors[:, 0], math.sqrt(values[0])
+    return omega, float(mode @ damping @ mode / (2.0 * omega * (mode @ mass @ mode)))
+
+
+def last_spins(series: dict, span: float = 30.0) -> str:
+    t, spin = series["time"], series["bit_angular_velocity"]
+    last = t > t[-1] - span
+    return (f"{spin[last].min():.2f} | {spin[last].max():.2f} | "
+            f"{np.mean(np.abs(spin[last]) < STUCK_SPIN):.3f}")
+
+
+def main() -> None:
+    rows, switched = [], []
+    for zeta, length, share in RUNS:
+        at, string = point(zeta, length)
+        simulation = start(at, string=string)
+        if share != 1.0:
+            simulation = start(at, string=string, dt=share * simulation.dt)
+        clock = time.perf_counter()
+        c = limit_cycle(at, 200.0, simulation=simulation)
+        period = "-" if c["period_s"] is None else f"{c['period_s']:.3f}"
+        added = zeta * math.pi * length / (8.0 * string.length)
+        rows.append(f"| {zeta:g} | {100 * added:.3f} | {length:g} | {share:g} | {c['settled']} | {period} | "
+                    f"{c['min_bit_spin_rad_s']:.2f} | {c['max_bit_spin_rad_s']:.2f} | {c['stuck_share']:.3f} | "
+                    f"{time.perf_counter() - clock:.1f} |")
+        print(rows[-1], flush=True)
+    for first, then in ((0.0, 0.25), (0.25, 0.0)):
+        at, string = point(first)
+        before = start(at, string=string)
+        spins_before = last_spins(before.run(120.0))
+        at, string = point(then)
+        after = start(at, string=string)
+        after.state, after.drive = before.state, before.drive
+        switched.append(f"| {first:g} | {spins_before} | {then:g} | {last_spins(after.run(150.0))} |")
+        print(switched[-1], flush=True)
+    omega, ratio = first_torsional_damping_ratio(point(0.0)[1])
+    lines = ["# How much damping the VBH well's stick-slip survives", "",
+             f"Command: `python benchmarks/stick_slip_margin.py`. Machine: {machine()}; one process. {SCENE} with the "
+             f"settings of `make well-maps`, the stiff drive, {WEIGHT / 1e3:g} kN and {RPM:g} rpm; each run to its "
+             "limit cycle or 200 s. zeta: `stick_slip_map.mesh_viscosity`, and the damping ratio it adds at the "
+             "first torsional mode, zeta pi h / (8 L); step: the share of the default step. The string's own "
+             f"damping (38) at its first torsional mode (held at the top, {omega:.3f} rad/s): {100 * ratio:.3f} % of "
+             "critical.", "",
+             "| zeta | added at the first mode [%] | element [m] | step | settled | cycle [s] | slowest spin [rad/s] | "
+             "fastest spin [rad/s] | stuck share | wall [s] |", "|---|---|---|---|---|---|---|---|---|---|", *rows, "",
+             f"Stepped 120 s with one zeta, then 150 s more from that state with the other (the bit's spin over the "
+             f"last 30 s of each; stuck: below {STUCK_SPIN:g} rad/s):", "",
+             "| zeta first | slowest spin [rad/s] | fastest spin [rad/s] | stuck share | zeta then | slowest spin "
+             "[rad/s] | fastest spin [rad/s] | stuck share |", "|---|---|---|---|---|---|---|---|", *switched]
+    out = ROOT / "benchmarks" / "results" / "stick_slip_margin.md"
+    out.write_text("\n".join(lines) + "\n")
+    print(f"-> {out}")
+
+
+if __name__ == "__main__":
+    main()
