@@ -23,7 +23,7 @@ from fenics_drill.model.axial_torsional_string import axial_torsional_string, pr
 from fenics_drill.model.well import check_weight_on_bit
 from fenics_drill.scene import SceneError
 from fenics_drill.studies.lifecycle import scene_record, stop_if_requested, study_run
-from fenics_drill.studies.stick_slip import StepFailed, limit_cycle, start
+from fenics_drill.studies.stick_slip import StepFailed, first_torsional_period, limit_cycle, start
 
 #: What each point reports, with its unit, in map.nc and map.csv.
 REPORTED = {"severity": "-", "period_s": "s", "stuck_share": "-", "max_bit_spin_rad_s": "rad/s",
@@ -186,7 +186,7 @@ def write_stick_slip_map(scene, out: str | Path, resume: bool = False, overwrite
         if not all_done(out, comm, progress):
             return None
         results = [_read_point(_point_path(out, i)) for i in range(len(points))]
-        study = _assembled(scene, results, time.perf_counter() - clock, comm.size)
+        study = _assembled(scene, string, results, time.perf_counter() - clock, comm.size)
         write_atomic(out / "map.nc", lambda tmp: study["map"].to_netcdf(tmp, engine="h5netcdf"))
         write_atomic(out / "map.csv", lambda tmp: Path(tmp).write_text(_csv(scene, points, results)))
         write_json(out / "map.json", study["report"])
@@ -211,7 +211,7 @@ def _csv(scene, points, results) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _assembled(scene, results: list[dict], seconds: float, ranks: int) -> dict:
+def _assembled(scene, string, results: list[dict], seconds: float, ranks: int) -> dict:
     import xarray as xr
 
     m = scene.stick_slip_map
@@ -244,6 +244,8 @@ def _assembled(scene, results: list[dict], seconds: float, ranks: int) -> dict:
     advice = []
     if scene.contact.static_factor > scene.contact.friction:
         advice.append(STATIC_FRICTION_ADVICE.format(length=m.element_length))
+    if m.mesh_viscosity > 0:
+        advice.append(viscosity_advice(scene, string))
     if m.step_check:
         report["step_moved_points"] = [i for i, r in enumerate(results) if r["step_moved"]]
         if report["step_moved_points"]:
@@ -261,6 +263,26 @@ STATIC_FRICTION_ADVICE = (
     "Aarsnes & Shor's case side by side, the stuck share read 0.46, 0.29 and 0.44 on 10, 5 and 2.5 m elements, while "
     "the mean and peak torque held within 0.6 % and the fastest spin within 1.2 %; check a point at half the "
     "elements' {length:g} m (stick_slip_map.element_length) before reading its cycle and stuck share")
+
+#: What a map with the mesh viscosity is told (docs/guide/stick_slip_maps.md, "The mesh viscosity").
+VISCOSITY_ADVICE = (
+    "stick_slip_map.mesh_viscosity = {zeta:g} damps the torsional waves by {first:.3f} % of critical at the string's "
+    "first torsional mode and {at_5_hz:.2f} % at 5 Hz, where the string's own damping (38) gives {own_first:.3f} % and "
+    "{own_5_hz:.3f} %: a stick-slip it removes hangs on damping the scene can only estimate; compare with the map at "
+    "0 (the stick-slip guide, 'The mesh viscosity')")
+
+
+def viscosity_advice(scene, string) -> str:
+    """VISCOSITY_ADVICE for the scene's string: the viscosity's ratio zeta h omega / (4 c_T) and (38)'s c / (2 omega)
+    at the first torsional mode held at the top (omega = 2 pi / (4 L / c_T)) and at 5 Hz, in %."""
+    zeta, h, c = scene.stick_slip_map.mesh_viscosity, scene.stick_slip_map.element_length, \
+        string.torsional_wave_speed_at_top
+    first, at_5_hz = 2.0 * math.pi / first_torsional_period(string), 2.0 * math.pi * 5.0
+    return VISCOSITY_ADVICE.format(zeta=zeta, first=100 * zeta * h * first / (4 * c),
+                                   at_5_hz=100 * zeta * h * at_5_hz / (4 * c),
+                                   own_first=100 * scene.beam.damping / (2 * first),
+                                   own_5_hz=100 * scene.beam.damping / (2 * at_5_hz))
+
 
 #: What a map whose points' cycles moved at half their step is told (docs/guide/stick_slip_maps.md, "The mesh
 #: viscosity").

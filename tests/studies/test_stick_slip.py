@@ -216,7 +216,8 @@ def test_a_maps_step_check_reports_the_half_step_and_flags_a_cycle_that_moved(tm
     ``stick_slip_map.step_check``: map.nc's half-step fastest spin is a run of the point at half its step
     (:func:`limit_cycle`, to 1e-12: the same steps), and ``step_moved`` says whether its fastest spin moved by more
     than 3 % of the drive's speed.  Without the mesh viscosity it moved (measured 36.23 and 37.50 rad/s, 6.7 % of
-    18.85 rad/s; benchmarks/results/stick_slip_step_check.md), with ζ = 1 it held (31.60 and 31.61 rad/s)."""
+    18.85 rad/s; benchmarks/results/stick_slip_step_check.md), with ζ = 1 it held (31.60 and 31.61 rad/s), and
+    map.json says what damping the viscosity adds."""
     out = tmp_path / "map"
     settings = ["drive.mode='hook_load'", "bit_rock.law='detournay'", "bit_rock.bit_radius='4.25 in'",
                 "stick_slip_map.weight_on_bit=['20 kN', '20 kN', 1]",
@@ -234,6 +235,12 @@ def test_a_maps_step_check_reports_the_half_step_and_flags_a_cycle_that_moved(tm
     advice = json.loads((out / "map.json").read_text()).get("advice", [])
     assert any("moved at half their step" in a for a in advice) is moved
     assert ("~: settled, but its cycle moved" in capsys.readouterr().out) is moved
+    # the viscosity's advice quotes its ratio at the first torsional mode held at the top, zeta pi h / (8 L) (c_T
+    # cancels), on the map's 10 m elements
+    first_mode = 100.0 * zeta * math.pi * point.stick_slip_map.element_length / (8.0 * start(point).string.length)
+    viscous = [a for a in advice if "damps the torsional waves" in a]
+    assert len(viscous) == (1 if zeta > 0 else 0)
+    assert all(f"by {first_mode:.3f} % of critical" in a for a in viscous)
 
 
 @pytest.mark.parametrize("setting, words", [
