@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from speed import processor  # noqa: E402
+from speed import processor, write_result  # noqa: E402
 from torsional_waves import limit_cycle_statistics  # noqa: E402
 
 import fenics_drill as fd  # noqa: E402
@@ -105,9 +105,7 @@ def main() -> None:
     lines += ["", "| drive | elements | step [ms] | cycle [s] | fastest spin [rad/s] | slowest spin [rad/s] | stuck share | "
               "surface torque [kN m] | its peak / tau_s | mean / kinetic torque - 1 | wall [s] |",
               "|---|---|---|---|---|---|---|---|---|---|---|", *rows]
-    out = ROOT / "benchmarks" / "results" / "off_bottom_well_b.md"
-    out.write_text("\n".join(lines) + "\n")
-    print(f"-> {out}")
+    write_result("off_bottom_well_b.md", lines)
     draw(figure_series, args.after, ROOT / "docs" / "figures" / "off_bottom_well_b.png", omega)
 
 

@@ -38,7 +38,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from speed import processor  # noqa: E402
+from speed import processor, write_result  # noqa: E402
 from torsional_waves import (BETA, ETA, K_A, LENGTH, V0, WEAR_FLAT, limit_cycle_statistics,  # noqa: E402
                             moving_top_cutting_law_case, published_scales)
 
@@ -100,9 +100,7 @@ def main() -> None:
              "translation is not in this repository).", "",
              "| model, case | cycle | cycles | fastest spin | stuck share | fastest bit velocity | mean bit velocity | "
              "wall [s] |", "|---|---|---|---|---|---|---|---|", *rows]
-    out = ROOT / "benchmarks" / "results" / "published_axial_torsional_model.md"
-    out.write_text("\n".join(lines) + "\n")
-    print(f"-> {out}")
+    write_result("published_axial_torsional_model.md", lines)
 
 
 if __name__ == "__main__":

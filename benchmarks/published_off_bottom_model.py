@@ -42,7 +42,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from off_bottom_well_b import spin_and_torque_figure  # noqa: E402
-from speed import processor  # noqa: E402
+from speed import processor, write_result  # noqa: E402
 from torsional_waves import limit_cycle_statistics, torsional_stick_slip  # noqa: E402
 
 import fenics_drill as fd  # noqa: E402
@@ -184,9 +184,7 @@ def main() -> None:
              "| model: case | cycle [s] | cycles | fastest spin [rad/s] | slowest spin [rad/s] | stuck share | "
              "mean motor torque [kN m] | motor torque [kN m] | wall [s] |",
              "|---|---|---|---|---|---|---|---|---|", *rows]
-    out = ROOT / "benchmarks" / "results" / "published_off_bottom_model.md"
-    out.write_text("\n".join(lines) + "\n")
-    print(f"-> {out}")
+    write_result("published_off_bottom_model.md", lines)
     draw(shown, args.after, ROOT / "docs" / "figures" / "published_off_bottom_model.png")
 
 

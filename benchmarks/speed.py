@@ -81,6 +81,14 @@ def processor() -> str:
     return platform.processor() or "CPU not reported"
 
 
+def write_result(name: str, lines: list[str]) -> Path:
+    """benchmarks/results/``name`` holding ``lines``, one per line; its path, printed."""
+    out = Path(__file__).resolve().parent / "results" / name
+    out.write_text("\n".join(lines) + "\n")
+    print(f"-> {out}")
+    return out
+
+
 def machine() -> str:
     """This machine as a results file states it: architecture, cores, CPU and Python."""
     return (f"{platform.machine()}, {os.cpu_count()} cores ({processor()}), Python {platform.python_version()}")

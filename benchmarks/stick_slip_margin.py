@@ -25,7 +25,7 @@ from scipy.linalg import eigh
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from speed import machine  # noqa: E402
+from speed import machine, write_result  # noqa: E402
 
 import fenics_drill as fd  # noqa: E402
 from fenics_drill.model.axial_torsional_string import axial_torsional_string, pressed_for  # noqa: E402
@@ -114,9 +114,7 @@ def main() -> None:
              f"last 30 s of each; stuck: below {STUCK_SPIN:g} rad/s):", "",
              "| zeta first | slowest spin [rad/s] | fastest spin [rad/s] | stuck share | zeta then | slowest spin "
              "[rad/s] | fastest spin [rad/s] | stuck share |", "|---|---|---|---|---|---|---|---|", *switched]
-    out = ROOT / "benchmarks" / "results" / "stick_slip_margin.md"
-    out.write_text("\n".join(lines) + "\n")
-    print(f"-> {out}")
+    write_result("stick_slip_margin.md", lines)
 
 
 if __name__ == "__main__":

@@ -29,7 +29,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from published_axial_torsional_model import DURATION, statistics  # noqa: E402
-from speed import machine  # noqa: E402
+from speed import machine, write_result  # noqa: E402
 from torsional_waves import (LENGTH, limit_cycle_statistics, moving_top_cutting_law_case, published_scales,  # noqa: E402
                              vertical_cutting_law_case)
 
@@ -127,9 +127,7 @@ def main() -> None:
              "| zeta | waves | element [m] | step | cycle [s] | fastest spin [rad/s] | slowest spin [rad/s] | "
              "stuck share | mean surface torque [kN m] | wall [s] |", "|---|---|---|---|---|---|---|---|---|---|",
              *calm_rows()]
-    out = ROOT / "benchmarks" / "results" / "stick_slip_mesh_convergence.md"
-    out.write_text("\n".join(lines) + "\n")
-    print(f"-> {out}")
+    write_result("stick_slip_mesh_convergence.md", lines)
 
 
 if __name__ == "__main__":

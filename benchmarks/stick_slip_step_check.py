@@ -17,7 +17,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from speed import machine  # noqa: E402
+from speed import machine, write_result  # noqa: E402
 
 import fenics_drill as fd  # noqa: E402
 from fenics_drill.model.axial_torsional_string import axial_torsional_string, pressed_for  # noqa: E402
@@ -56,9 +56,7 @@ def main() -> None:
              "| zeta | weight on bit [kN] | rotation speed [rpm] | step | settled | cycle [s] | fastest spin [rad/s] | "
              "stuck share | severity | surface torque [kN m] | wall [s] |",
              "|---|---|---|---|---|---|---|---|---|---|---|", *rows]
-    out = ROOT / "benchmarks" / "results" / "stick_slip_step_check.md"
-    out.write_text("\n".join(lines) + "\n")
-    print(f"-> {out}")
+    write_result("stick_slip_step_check.md", lines)
 
 
 if __name__ == "__main__":

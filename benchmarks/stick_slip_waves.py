@@ -34,7 +34,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from speed import processor  # noqa: E402
+from speed import processor, write_result  # noqa: E402
 from torsional_waves import (inclined_wall_friction_case, limit_cycle_statistics, vertical_cutting_law_case,  # noqa: E402
                              vertical_paper_law_case)
 
@@ -175,9 +175,7 @@ def main() -> None:
                   "Aarsnes & Shor's well B); the wave guides carry the same wall law cell by cell.", "", *HEADER,
                   *compiled_rows(case, GRIDS[:3], args.t_end, args.after),
                   *reference_rows(case, args.t_end, args.after, CELLS[:2])]
-    out = ROOT / "benchmarks" / "results" / "stick_slip_waves.md"
-    out.write_text("\n".join(lines) + "\n")
-    print(f"-> {out}")
+    write_result("stick_slip_waves.md", lines)
 
 
 if __name__ == "__main__":

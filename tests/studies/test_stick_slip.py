@@ -371,6 +371,9 @@ def test_the_mesh_viscosity_holds_a_violent_bits_cycle_and_keeps_a_calm_bits_sti
             simulation = start(scene, simulation.string, dt=share * simulation.dt)
         runs[elements, share] = limit_cycle_statistics(simulation.run(duration), scene.drive.rotation_speed, after)
     exact = limit_cycle_statistics(reference(duration), scene.drive.rotation_speed, after)
+    # 0.3 %: above the viscous runs' spread over every step and mesh of the benchmark (1.294-1.296), and well below
+    # the shift without the viscosity (5 m elements read 2.2 % short); 0.03 of stuck share is the map's own
+    # settled-cycle tolerance (stick_slip_map's step check)
     for run in runs.values():
         assert run["period"] == pytest.approx(exact["period"], rel=0.003)
         assert abs(run["stuck_share"] - exact["stuck_share"]) < 0.03
