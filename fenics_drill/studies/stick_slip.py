@@ -282,9 +282,19 @@ def mean_period(series: dict, rotation_speed: float) -> float | None:
     return float(np.mean([np.ptp(series["time"][c]) for c in whole]))
 
 
+def median_cycle_peak(series: dict, rotation_speed: float) -> float | None:
+    """The median over the whole cycles in ``series`` (:func:`cycles`) of each cycle's fastest spin of the bit, None
+    without one: an irregular cycle's typical slip, where the fastest spin over all the cycles is the extreme of
+    their spread."""
+    whole = cycles(series, rotation_speed)
+    if not whole:
+        return None
+    return float(np.median([series["bit_angular_velocity"][c].max() for c in whole]))
+
+
 def cycle_metrics(series: dict, rotation_speed: float, bit_area: float, steady: bool) -> dict:
     """The cycle over ``series``: severity (max - min) / (2 mean) of the bit's spin, its period (the mean duration
-    of the whole cycles in ``series``), the stuck share, the means of the rop, the surface torque, the hook load and
+    of the whole cycles in ``series``), the stuck share, the median cycle's fastest spin, the means of the rop, the surface torque, the hook load and
     the weight on bit, and the mechanical specific energy at the bit, W / A + <T omega> / (A rop) (Teale 1965, with
     the bit's torque and spin) [Pa]."""
     m = window_metrics(series, rotation_speed)
@@ -293,6 +303,7 @@ def cycle_metrics(series: dict, rotation_speed: float, bit_area: float, steady: 
         "severity": float((m["max_spin"] - m["min_spin"]) / (2.0 * mean_spin)) if mean_spin > 0 else math.inf,
         "period_s": None if steady else mean_period(series, rotation_speed),
         "stuck_share": m["stuck_share"], "max_bit_spin_rad_s": m["max_spin"], "min_bit_spin_rad_s": m["min_spin"],
+        "median_cycle_max_bit_spin_rad_s": None if steady else median_cycle_peak(series, rotation_speed),
         "mean_bit_spin_rad_s": mean_spin, "rop_m_s": m["rop"], "surface_torque_N_m": m["surface_torque"],
         "hook_load_N": m["hook_load"], "weight_on_bit_N": m["weight_on_bit"], "bit_torque_N_m": m["bit_torque"],
         "mechanical_specific_energy_Pa": (m["weight_on_bit"] / bit_area + m["bit_power"] / (bit_area * m["rop"])

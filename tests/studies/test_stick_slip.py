@@ -15,7 +15,7 @@ from torsional_waves import (limit_cycle_statistics, moving_top_cutting_law_case
 import fenics_drill as fd
 from fenics_drill.cli import main
 from fenics_drill.solvers.axial_torsional_step import band_product, band_solve
-from fenics_drill.studies.stick_slip import cycle_metrics, limit_cycle, start
+from fenics_drill.studies.stick_slip import cycle_metrics, limit_cycle, median_cycle_peak, start
 from fenics_drill.studies.stick_slip_map import map_scene, point_scene
 
 BUILD_HOLD = "demos/scenes/well_build_hold.toml"
@@ -273,7 +273,10 @@ def test_a_moving_tops_bouncing_cycle_is_the_wave_guides_solved_along_their_char
     torsional characteristics (1.25 m cells), over [60, 120] of their time units: the mean cycle within 1 % (measured
     0.01 %), the stuck share within 0.02 (0.003), the fastest spin and the fastest bit velocity within 6 % (3.1 % low
     and 2.4 % high; the reference's own 1.25 and 0.625 m cells spread each by 0.4 %, and these peaks are the cycle's
-    sharpest features, where the bit breaks free and lands, which the 10 m elements resolve least)."""
+    sharpest features, where the bit breaks free and lands, which the 10 m elements resolve least).  The cycle is
+    irregular: each cycle's own fastest spin spreads over 2.76-3.26 (10th-90th percentile) in the exact solution, and
+    the median of those peaks (``median_cycle_peak``) agrees within 4 % (measured 1.7 % low; the reference's 2.5 and
+    0.625 m cells move it by 0.5 %, and 4 % is a quarter of the cycles' own spread)."""
     scene, reference = moving_top_cutting_law_case(1.0)
     scale = published_scales()
     duration, after = 120.0 * scale["time"], 60.0 * scale["time"]
@@ -286,6 +289,9 @@ def test_a_moving_tops_bouncing_cycle_is_the_wave_guides_solved_along_their_char
     assert ours["max_spin"] == pytest.approx(theirs["max_spin"], rel=0.06)
     fastest = [series["bit_velocity"][series["time"] > after].max() for series in (mine, exact)]
     assert fastest[0] == pytest.approx(fastest[1], rel=0.06)
+    typical = [median_cycle_peak({k: v[series["time"] > after] for k, v in series.items()}, omega)
+               for series in (mine, exact)]
+    assert typical[0] == pytest.approx(typical[1], rel=0.04)
 
 
 def test_a_map_with_the_walls_static_friction_is_told_its_cycle_moves_with_the_mesh(tmp_path, capsys):
