@@ -482,9 +482,9 @@ def published_scales() -> dict:
             "torque": torque, "specific_energy": energy}
 
 
-def moving_top_cutting_law_case(omega0: float, elements: int = 200):
-    """(scene, reference): their case at the set spin ``omega0`` (their units) stated for 2000 m of 5 in pipe without
-    gravity, its top held moving at their v0 and turning at omega0, the cutting law scaled by
+def moving_top_cutting_law_case(omega0: float, elements: int = 200, v0: float = V0):
+    """(scene, reference): their case at the set spin ``omega0`` and top velocity ``v0`` (their units) stated for
+    2000 m of 5 in pipe without gravity, its top held moving at v0 and turning at omega0, the cutting law scaled by
     :func:`published_scales` (zeta = 1, l = 1.2 mm, mu = 0.5, a 4-blade bit of 0.108 m held against turning
     backwards, as theirs sticks), damped at their -ln(eta) per time unit; and ``reference(duration, cell)``:
     :func:`axial_torsional_stick_slip` of that string and law, the top held moving."""
@@ -521,9 +521,9 @@ lateral_length = 0.0
 friction = 0.0
 [drive]
 mode = "velocity"
-axial_velocity = {V0 * s["velocity"]!r}
+axial_velocity = {v0 * s["velocity"]!r}
 rotation_speed = {omega0 * s["spin"]!r}
-weight_on_bit = {(K_A * V0 / omega0 + WEAR_FLAT) * s["weight"]!r}
+weight_on_bit = {(K_A * v0 / omega0 + WEAR_FLAT) * s["weight"]!r}
 start = "on_bottom"
 [bit_rock]
 law = "detournay"

@@ -42,6 +42,33 @@ def power_spectral_density(values: np.ndarray, step: float) -> tuple[np.ndarray,
     return signal.periodogram(values, fs=1.0 / step, detrend="constant", scaling="density")
 
 
+#: Zero-padding of :func:`dominant_period`'s transform: bins this many times finer than the record's own.
+PADDING = 16
+
+
+def dominant_period(t: np.ndarray, values: np.ndarray) -> float | None:
+    """The period [s] of the largest peak of the Hann-windowed power spectrum of a signal sampled at ``t``, its
+    transform zero-padded :data:`PADDING` times and the peak placed by a parabola through the log power of its
+    three bins; peaks below 1.5 cycles over the record are not counted.  None for a record too short or flat."""
+    if t.size < 8 or np.ptp(values) == 0.0:
+        return None
+    grid = uniform_grid(t)
+    g = resample(t, values, grid)
+    g = (g - g.mean()) * np.hanning(g.size)
+    size = 1 << int(np.ceil(np.log2(PADDING * g.size)))
+    power = np.abs(np.fft.rfft(g, size)) ** 2
+    freq = np.fft.rfftfreq(size, grid[1] - grid[0])
+    low = int(np.searchsorted(freq, 1.5 / (grid[-1] - grid[0])))
+    if low >= power.size - 1:
+        return None
+    k = low + int(np.argmax(power[low:-1]))
+    if k == 0 or power[k] <= 0.0:
+        return None
+    a, b, c = np.log(np.maximum(power[k - 1:k + 2], 1e-300))
+    shift = 0.5 * (a - c) / (a - 2.0 * b + c) if a - 2.0 * b + c < 0.0 else 0.0
+    return float(1.0 / (freq[k] + shift * (freq[1] - freq[0])))
+
+
 def to_db(psd: np.ndarray) -> np.ndarray:
     """10 log10(PSD / 1) in dB/Hz (floored at 1e-30 to stay finite)."""
     return 10.0 * np.log10(np.maximum(psd, 1e-30))

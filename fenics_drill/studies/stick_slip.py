@@ -28,6 +28,7 @@ from fenics_drill.model.axial_torsional_string import AxialTorsionalString, axia
 from fenics_drill.model.forces.cutting_bit import cutting_law_constants
 from fenics_drill.model.top_drive import controller_gains
 from fenics_drill.model.well import hanging_tension
+from fenics_drill.observables.spectra import dominant_period
 from fenics_drill.scene import LAW_SIGN
 from fenics_drill.solvers.axial_torsional_step import (CONVERGED, CUTTING, NO_BIT, PAPER, RECORDED, advance,
                                                       band_solve)
@@ -294,7 +295,9 @@ def median_cycle_peak(series: dict, rotation_speed: float) -> float | None:
 
 def cycle_metrics(series: dict, rotation_speed: float, bit_area: float, steady: bool) -> dict:
     """The cycle over ``series``: severity (max - min) / (2 mean) of the bit's spin, its period (the mean duration
-    of the whole cycles in ``series``), the stuck share, the median cycle's fastest spin, the means of the rop, the surface torque, the hook load and
+    of the whole cycles in ``series``) and its dominant period (:func:`~fenics_drill.observables.spectra.dominant_period`
+    of the bit's spin: a cycle of several unequal slips repeats over it), the stuck share, the median cycle's fastest
+    spin, the means of the rop, the surface torque, the hook load and
     the weight on bit, and the mechanical specific energy at the bit, W / A + <T omega> / (A rop) (Teale 1965, with
     the bit's torque and spin) [Pa]."""
     m = window_metrics(series, rotation_speed)
@@ -302,6 +305,7 @@ def cycle_metrics(series: dict, rotation_speed: float, bit_area: float, steady: 
     return {
         "severity": float((m["max_spin"] - m["min_spin"]) / (2.0 * mean_spin)) if mean_spin > 0 else math.inf,
         "period_s": None if steady else mean_period(series, rotation_speed),
+        "dominant_period_s": None if steady else dominant_period(series["time"], series["bit_angular_velocity"]),
         "stuck_share": m["stuck_share"], "max_bit_spin_rad_s": m["max_spin"], "min_bit_spin_rad_s": m["min_spin"],
         "median_cycle_max_bit_spin_rad_s": None if steady else median_cycle_peak(series, rotation_speed),
         "mean_bit_spin_rad_s": mean_spin, "rop_m_s": m["rop"], "surface_torque_N_m": m["surface_torque"],

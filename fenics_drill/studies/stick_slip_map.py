@@ -26,7 +26,7 @@ from fenics_drill.studies.lifecycle import scene_record, stop_if_requested, stud
 from fenics_drill.studies.stick_slip import StepFailed, first_torsional_period, limit_cycle, start
 
 #: What each point reports, with its unit, in map.nc and map.csv.
-REPORTED = {"severity": "-", "period_s": "s", "stuck_share": "-", "max_bit_spin_rad_s": "rad/s",
+REPORTED = {"severity": "-", "period_s": "s", "dominant_period_s": "s", "stuck_share": "-", "max_bit_spin_rad_s": "rad/s",
             "min_bit_spin_rad_s": "rad/s", "median_cycle_max_bit_spin_rad_s": "rad/s", "mean_bit_spin_rad_s": "rad/s", "rop_m_s": "m/s",
             "surface_torque_N_m": "N m", "hook_load_N": "N", "weight_on_bit_N": "N", "bit_torque_N_m": "N m",
             "mechanical_specific_energy_Pa": "Pa", "time_s": "s", "wall_time_s": "s"}
@@ -246,6 +246,9 @@ def _assembled(scene, string, results: list[dict], seconds: float, ranks: int) -
         advice.append(STATIC_FRICTION_ADVICE.format(length=m.element_length))
     if m.mesh_viscosity > 0:
         advice.append(viscosity_advice(scene, string))
+    report["irregular_points"] = [i for i, r in enumerate(results) if irregular(r)]
+    if report["irregular_points"]:
+        advice.append(IRREGULAR_ADVICE.format(count=len(report["irregular_points"]), share=100 * IRREGULAR_PERIOD))
     if m.step_check:
         report["step_moved_points"] = [i for i, r in enumerate(results) if r["step_moved"]]
         if report["step_moved_points"]:
@@ -254,6 +257,25 @@ def _assembled(scene, string, results: list[dict], seconds: float, ranks: int) -
     if advice:
         report["advice"] = advice
     return {"report": report, "map": dataset}
+
+
+#: A cycle whose period between rises through the drive's speed and whose dominant period differ by more than this
+#: share is irregular, or repeats over several unequal slips.
+IRREGULAR_PERIOD = 0.1
+IRREGULAR_ADVICE = (
+    "{count} point(s) have a cycle whose period between rises through the drive's speed (period_s) and whose "
+    "dominant period (dominant_period_s) differ by more than {share:g} %: the cycle repeats over several unequal "
+    "slips or is irregular; read both, and median_cycle_max_bit_spin_rad_s beside max_bit_spin_rad_s (the stick-slip "
+    "guide, 'The limit cycle')")
+
+
+def irregular(result: dict) -> bool:
+    """Whether a point's period_s and dominant_period_s differ by more than IRREGULAR_PERIOD (False where either is
+    missing)."""
+    period, dominant = result.get("period_s"), result.get("dominant_period_s")
+    if period is None or dominant is None or not (period > 0 and dominant > 0):
+        return False
+    return abs(dominant / period - 1.0) > IRREGULAR_PERIOD
 
 
 #: What a map with the wall's static friction is told (docs/guide/stick_slip_maps.md, "Against the authors' published
