@@ -47,6 +47,7 @@ from speed import processor, write_result  # noqa: E402
 from torsional_waves import (BETA, ETA, K_A, LENGTH, V0, WEAR_FLAT, limit_cycle_statistics,  # noqa: E402
                             moving_top_cutting_law_case, published_scales)
 
+from fenics_drill.observables.spectra import dominant_period  # noqa: E402
 from fenics_drill.studies.stick_slip import cycles, start  # noqa: E402
 
 #: The set spins compared (their first, and their second at the same v0), and the time units run and skipped.
@@ -63,12 +64,24 @@ def statistics(t: np.ndarray, velocity: np.ndarray, spin: np.ndarray, omega0: fl
     late = t > AFTER
     peaks = [spin[late][rows].max() for rows in cycles({k: v[late] for k, v in series.items()}, omega0)]
     return {**s, "max_velocity": float(velocity[late].max()), "mean_velocity": float(velocity[late].mean()),
-            "cycle_peaks": np.percentile(peaks, (50, 10, 90))}
+            "cycle_peaks": np.percentile(peaks, (50, 10, 90)), "dominant_period": dominant_period(t[late], spin[late])}
+
+
+def scaled_statistics(series: dict, omega0: float) -> dict:
+    """:func:`statistics` of a run of this string (SI units), in their units."""
+    s = published_scales()
+    return statistics(series["time"] / s["time"], series["bit_velocity"] / s["velocity"],
+                      series["bit_angular_velocity"] / s["spin"], omega0)
+
+
+def peaks_cell(s: dict) -> str:
+    """Each cycle's fastest spin as a table cell: the median (10th-90th percentile)."""
+    median, low, high = s["cycle_peaks"]
+    return f"{median:.3f} ({low:.2f}-{high:.2f})"
 
 
 def row(name: str, s: dict, wall: float | None) -> str:
-    median, low, high = s["cycle_peaks"]
-    return (f"| {name} | {s['period']:.3f} | {s['cycles']} | {s['max_spin']:.3f} | {median:.3f} ({low:.2f}-{high:.2f}) "
+    return (f"| {name} | {s['period']:.3f} | {s['cycles']} | {s['max_spin']:.3f} | {peaks_cell(s)} "
             f"| {s['stuck_share']:.3f} | {s['max_velocity']:.2f} | {s['mean_velocity']:.3f} | "
             f"{'' if wall is None else f'{wall:.1f}'} |")
 
@@ -101,8 +114,7 @@ def main() -> None:
             clock = time.perf_counter()
             series = start(scene.with_changes(stick_slip_map={"mesh_viscosity": zeta})).run(DURATION * s["time"])
             wall = time.perf_counter() - clock
-            mine = statistics(series["time"] / s["time"], series["bit_velocity"] / s["velocity"],
-                              series["bit_angular_velocity"] / s["spin"], omega0)
+            mine = scaled_statistics(series, omega0)
             rows.append(row(f"this string, omega0 = {omega0:g}, {LENGTH / args.elements:g} m elements"
                             + (f", mesh viscosity {zeta:g}" if zeta else ""), mine, wall))
             print(rows[-1], flush=True)
@@ -110,8 +122,7 @@ def main() -> None:
         exact = exact_run(DURATION * s["time"], CELL)
         wall = time.perf_counter() - clock
         rows.append(row(f"this string's law, exact characteristics, omega0 = {omega0:g}, {CELL:g} m cells",
-                        statistics(exact["time"] / s["time"], exact["bit_velocity"] / s["velocity"],
-                                   exact["bit_angular_velocity"] / s["spin"], omega0), wall))
+                        scaled_statistics(exact, omega0), wall))
         print(rows[-1], flush=True)
     lines = ["# Aarsnes & van de Wouw's published axial-torsional model on bottom, side by side with this string", "",
              f"Command: `python benchmarks/published_axial_torsional_model.py --published-series DIR --elements "

@@ -19,11 +19,10 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from published_axial_torsional_model import AFTER, DURATION, statistics  # noqa: E402
+from published_axial_torsional_model import AFTER, DURATION, peaks_cell, scaled_statistics  # noqa: E402
 from speed import machine, write_result  # noqa: E402
 from torsional_waves import moving_top_cutting_law_case, published_scales  # noqa: E402
 
-from fenics_drill.observables.spectra import dominant_period  # noqa: E402
 from fenics_drill.studies.stick_slip import start  # noqa: E402
 
 #: Their MAIN.m's cases: (omega0, v0) in their units.
@@ -31,31 +30,25 @@ CASES = ((1.0, 2.0), (1.8, 2.0), (3.2, 2.0), (2.2, 10.0), (3.5, 10.0), (6.3, 10.
 CELL = 1.25
 
 
-def row(label: str, t, velocity, spin, omega0: float, wall: float) -> str:
-    m = statistics(t, velocity, spin, omega0)
-    late = t > AFTER
-    median, low, high = m["cycle_peaks"]
-    line = (f"| {label} | {m['period']:.3f} | {dominant_period(t[late], spin[late]):.3f} | {m['max_spin']:.3f} | "
-            f"{median:.3f} ({low:.2f}-{high:.2f}) | {m['stuck_share']:.3f} | {wall:.1f} |")
+def row(label: str, series: dict, omega0: float, wall: float) -> str:
+    m = scaled_statistics(series, omega0)
+    line = (f"| {label} | {m['period']:.3f} | {m['dominant_period']:.3f} | {m['max_spin']:.3f} | {peaks_cell(m)} | "
+            f"{m['stuck_share']:.3f} | {wall:.1f} |")
     print(line, flush=True)
     return line
 
 
 def main() -> None:
-    s = published_scales()
+    duration = DURATION * published_scales()["time"]
     rows = []
     for omega0, v0 in CASES:
         scene, exact_run = moving_top_cutting_law_case(omega0, 200, v0)
         clock = time.perf_counter()
-        series = start(scene).run(DURATION * s["time"])
-        rows.append(row(f"{omega0:g}, {v0:g}, 10 m elements", series["time"] / s["time"],
-                        series["bit_velocity"] / s["velocity"], series["bit_angular_velocity"] / s["spin"], omega0,
-                        time.perf_counter() - clock))
+        series = start(scene).run(duration)
+        rows.append(row(f"{omega0:g}, {v0:g}, 10 m elements", series, omega0, time.perf_counter() - clock))
         clock = time.perf_counter()
-        exact = exact_run(DURATION * s["time"], CELL)
-        rows.append(row(f"{omega0:g}, {v0:g}, exact characteristics", exact["time"] / s["time"],
-                        exact["bit_velocity"] / s["velocity"], exact["bit_angular_velocity"] / s["spin"], omega0,
-                        time.perf_counter() - clock))
+        exact = exact_run(duration, CELL)
+        rows.append(row(f"{omega0:g}, {v0:g}, exact characteristics", exact, omega0, time.perf_counter() - clock))
     lines = ["# The period of an irregular stick-slip cycle, read two ways", "",
              f"Command: `python benchmarks/stick_slip_irregular_cycles.py`. Machine: {machine()}; one process. "
              "Aarsnes & van de Wouw's cases (their MAIN.m; benchmarks/published_axial_torsional_model.py states them "

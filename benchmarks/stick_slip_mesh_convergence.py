@@ -28,7 +28,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from published_axial_torsional_model import DURATION, statistics  # noqa: E402
+from published_axial_torsional_model import DURATION, peaks_cell, scaled_statistics  # noqa: E402
 from speed import machine, write_result  # noqa: E402
 from torsional_waves import (LENGTH, limit_cycle_statistics, moving_top_cutting_law_case, published_scales,  # noqa: E402
                              vertical_cutting_law_case)
@@ -89,12 +89,9 @@ def calm_rows() -> list[str]:
 
 def violent_row(label: str, series: dict, wall: float) -> str:
     """A row of the violent case's table (their units), printed as it is made."""
-    s = published_scales()
-    m = statistics(series["time"] / s["time"], series["bit_velocity"] / s["velocity"],
-                   series["bit_angular_velocity"] / s["spin"], 1.0)
-    median, low, high = m["cycle_peaks"]
-    row = (f"| {label} | {m['period']:.3f} | {m['max_spin']:.3f} | {median:.3f} ({low:.2f}-{high:.2f}) | "
-           f"{m['stuck_share']:.3f} | {m['max_velocity']:.2f} | {m['mean_velocity']:.3f} | {wall:.1f} |")
+    m = scaled_statistics(series, 1.0)
+    row = (f"| {label} | {m['period']:.3f} | {m['max_spin']:.3f} | {peaks_cell(m)} | {m['stuck_share']:.3f} | "
+           f"{m['max_velocity']:.2f} | {m['mean_velocity']:.3f} | {wall:.1f} |")
     print(row, flush=True)
     return row
 
