@@ -246,7 +246,7 @@ def _assembled(scene, string, results: list[dict], seconds: float, ranks: int) -
         advice.append(STATIC_FRICTION_ADVICE.format(length=m.element_length))
     if m.mesh_viscosity > 0:
         advice.append(viscosity_advice(scene, string))
-    report["irregular_points"] = [i for i, r in enumerate(results) if irregular(r)]
+    report["irregular_points"] = [i for i, r in enumerate(results) if r["settled"] and irregular(r)]
     if report["irregular_points"]:
         advice.append(IRREGULAR_ADVICE.format(count=len(report["irregular_points"]), share=100 * IRREGULAR_PERIOD))
     if m.step_check:
@@ -263,7 +263,7 @@ def _assembled(scene, string, results: list[dict], seconds: float, ranks: int) -
 #: share is irregular, or repeats over several unequal slips.
 IRREGULAR_PERIOD = 0.1
 IRREGULAR_ADVICE = (
-    "{count} point(s) have a cycle whose period between rises through the drive's speed (period_s) and whose "
+    "{count} settled point(s) have a cycle whose period between rises through the drive's speed (period_s) and whose "
     "dominant period (dominant_period_s) differ by more than {share:g} %: the cycle repeats over several unequal "
     "slips or is irregular; read both, and median_cycle_max_bit_spin_rad_s beside max_bit_spin_rad_s (the stick-slip "
     "guide, 'The limit cycle')")
