@@ -295,11 +295,11 @@ def median_cycle_peak(series: dict, rotation_speed: float) -> float | None:
 
 def cycle_metrics(series: dict, rotation_speed: float, bit_area: float, steady: bool) -> dict:
     """The cycle over ``series``: severity (max - min) / (2 mean) of the bit's spin, its period (the mean duration
-    of the whole cycles in ``series``) and its dominant period (:func:`~fenics_drill.observables.spectra.dominant_period`
-    of the bit's spin: a cycle of several unequal slips repeats over it), the stuck share, the median cycle's fastest
-    spin, the means of the rop, the surface torque, the hook load and
-    the weight on bit, and the mechanical specific energy at the bit, W / A + <T omega> / (A rop) (Teale 1965, with
-    the bit's torque and spin) [Pa]."""
+    of the whole cycles in ``series``) and its dominant period, over which a cycle of several unequal slips repeats
+    (:func:`~fenics_drill.observables.spectra.dominant_period` of the bit's spin), the stuck share, the median
+    cycle's fastest spin (:func:`median_cycle_peak`), the means of the rop, the surface torque, the hook load and the
+    weight on bit, and the mechanical specific energy at the bit, W / A + <T omega> / (A rop) (Teale 1965, with the
+    bit's torque and spin) [Pa]."""
     m = window_metrics(series, rotation_speed)
     mean_spin = m["mean_spin"]
     return {

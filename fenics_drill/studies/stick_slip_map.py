@@ -26,8 +26,9 @@ from fenics_drill.studies.lifecycle import scene_record, stop_if_requested, stud
 from fenics_drill.studies.stick_slip import StepFailed, first_torsional_period, limit_cycle, start
 
 #: What each point reports, with its unit, in map.nc and map.csv.
-REPORTED = {"severity": "-", "period_s": "s", "dominant_period_s": "s", "stuck_share": "-", "max_bit_spin_rad_s": "rad/s",
-            "min_bit_spin_rad_s": "rad/s", "median_cycle_max_bit_spin_rad_s": "rad/s", "mean_bit_spin_rad_s": "rad/s", "rop_m_s": "m/s",
+REPORTED = {"severity": "-", "period_s": "s", "dominant_period_s": "s", "stuck_share": "-",
+            "max_bit_spin_rad_s": "rad/s", "min_bit_spin_rad_s": "rad/s", "median_cycle_max_bit_spin_rad_s": "rad/s",
+            "mean_bit_spin_rad_s": "rad/s", "rop_m_s": "m/s",
             "surface_torque_N_m": "N m", "hook_load_N": "N", "weight_on_bit_N": "N", "bit_torque_N_m": "N m",
             "mechanical_specific_energy_Pa": "Pa", "time_s": "s", "wall_time_s": "s"}
 #: What a point checked at half its step (``stick_slip_map.step_check``) reports of that run, as ``half_step_<name>``.
