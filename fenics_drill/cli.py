@@ -445,7 +445,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true", help="with --samples: continue the study in --out")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_torque_drag)
-    p = sub.add_parser("stick-slip-map", help="stick-slip severity, period, stuck share, rop and specific energy "
+    p = sub.add_parser("stick-slip-map", help="stick-slip severity, period (between rises and dominant), stuck share, "
+                                              "fastest and median cycle's bit spin, rop and specific energy "
                                               "over weight on bit x rotation speed on the axial-torsional string "
                                               "(MPI-parallel, resumable): DIR/map.nc, map.csv, map.json")
     _scene_args(p)
