@@ -128,6 +128,8 @@ class Contact:
     static_friction: float = key(-1.0, "the wall's static friction factor (no lateral fields; it caps a run's step); "
                                  "-1: contact.friction [-]", lambda x: x == -1 or x >= 0, "-1 or >= 0")
     static_slip_speed: float = _nonneg("slip speed below which the static factor holds a sliding contact [m/s]", 0.0)
+    normal_force: str = key("static", "the wall's normal force without lateral fields: 'static' (the soft string's) or "
+                            "'dynamic' (tension)", choices=("static", "dynamic"))
 
     @property
     def static_factor(self) -> float:

@@ -8,7 +8,8 @@ An update that does not reduce the residual is cut first to just past the first 
 (the FE Newton's line search, :func:`~fenics_drill.solvers.newton.backtrack`), then by halves: a full update that
 jumps the wear flats' contact ramp (v_c wide) otherwise cycles between its branches until the step is halved.
 
-* **Wall**: at each vertex the Coulomb force at the contact point by return mapping
+* **Wall**: at each vertex, pressed by its normal force (the soft string's, or its own axial force's at each
+  accepted step: ``contact.normal_force``), the Coulomb force at the contact point by return mapping
   (:func:`~fenics_drill.model.forces.wall.coulomb._return_map`, the FE wall's law), its slip (du, R d theta_x)
   since the step's start and its stuck spring k_t; its factor kinetic where the vertex slid at the last step at
   least as fast as the static slip speed, static elsewhere
@@ -32,6 +33,7 @@ import math
 import numpy as np
 from numba import njit
 
+from fenics_drill.model.forces.axial_torsional_wall import _pressed_normals
 from fenics_drill.model.forces.bit_rock import LAW as PAPER_LAW
 from fenics_drill.model.forces.bit_rock import fraction_past_kink
 from fenics_drill.model.forces.cutting_bit import cutting_law, cutting_law_kink, surface_at
@@ -268,13 +270,16 @@ ROUND_OFF = 1e-14
 
 
 @kernel
-def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, wall_law, bit_kind, bit_law,
-            drive, dt, newmark, tolerance, max_iterations, steps, stride, q, v, a, clock, anchor, held, surface,
-            surface_state, records, counters):
+def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, arm, press, wall_law, bit_kind,
+            bit_law, drive, dt, newmark, tolerance, max_iterations, steps, stride, q, v, a, clock, anchor, held,
+            surface, surface_state, records, counters):
     """Take ``steps`` steps of ``dt`` from the state (q, v, a) at ``clock[0]`` (all updated in place) and write a
     row of :data:`RECORDED` into ``records`` every ``stride`` steps.  A step whose Newton does not converge is
     taken in halves (down to dt / 2 ** :data:`SUBSTEP_HALVINGS`).  Returns (status, rows written).
 
+    ``normal``: each vertex's normal force, pressed anew at each accepted step by ``press`` = (turn, weight, axis,
+    rigidity, lengths) of :class:`~fenics_drill.model.forces.axial_torsional_wall.TensionPress` from the string's
+    own axial force where its rigidity is not empty, held otherwise;
     ``wall_law``: (kinetic factor, stick stiffness, static factor, static slip speed); ``bit_law``: the law's constants (:data:`PAPER`: Gamma, alpha,
     mu, R; :data:`CUTTING`: :func:`~fenics_drill.model.forces.cutting_bit.cutting_law_constants` then the blade
     passage); ``drive``: (axial held, V0, top force, rotation held, Omega, k_p, k_i, T_max, z); ``anchor``,
@@ -316,6 +321,8 @@ def advance(mass, damping, stiffness, w, gravity, top, bit, wall_dofs, normal, a
             anchor[:, 1] = x[wall_dofs[:, 1]]
             held[:, :] = trial_held
             _next_factors(held, v, wall_dofs, arm, wall_law)
+            if press[3].size > 0:
+                _pressed_normals(anchor[:, 0], press[0], press[1], press[2], press[3], press[4], normal)
             drive[8] = ev[7]
             clock[0] += h
             remaining -= h

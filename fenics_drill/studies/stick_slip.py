@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fenics_drill.model.axial_torsional_string import AxialTorsionalString, axial_torsional_string, mesh_viscosity
+from fenics_drill.model.forces.axial_torsional_wall import tension_press
 from fenics_drill.model.forces.cutting_bit import cutting_law_constants
 from fenics_drill.model.top_drive import controller_gains
 from fenics_drill.model.well import hanging_tension
@@ -46,6 +47,8 @@ TORQUE_TOLERANCE = 0.02  # of the mean surface torque
 PERIOD_TOLERANCE = 0.03  # of the cycle's mean duration
 #: Newton's stop (the residual's largest entry against the string's weight) and its iterations per step.
 TOLERANCE, MAX_ITERATIONS = 1e-8, 40
+#: What the steps take for ``press`` where the wall's normal force is held (``contact.normal_force = 'static'``).
+NO_PRESS = (np.empty((0, 3)), np.empty(0), np.empty((0, 3)), np.empty(0), np.empty(0))
 #: The cut bottom's memory: (angle, surface) entries kept (more than two revolutions of accepted steps).
 SURFACE_CAPACITY = 1 << 16
 
@@ -168,8 +171,13 @@ def start(scene, string: AxialTorsionalString | None = None, dt: float | None = 
     damping = string.damping
     if scene.stick_slip_map.mesh_viscosity > 0:
         damping = damping + mesh_viscosity(string, scene.stick_slip_map.mesh_viscosity)
-    constants = (mass, damping, string.stiffness, w, string.gravity, string.top, string.bit, wall,
-                 string.wall_normal, string.wall_arm, wall_law, bit_kind, bit_law)
+    normal, press = string.wall_normal.copy(), NO_PRESS
+    if contact.normal_force == "dynamic" and scene.model.contact:
+        pressing = tension_press(scene, string.x[wall[:, 0]])
+        normal = pressing.normal_forces(q[wall[:, 0]])
+        press = (pressing.turn, pressing.weight, pressing.axis, pressing.rigidity, pressing.lengths)
+    constants = (mass, damping, string.stiffness, w, string.gravity, string.top, string.bit, wall, normal,
+                 string.wall_arm, press, wall_law, bit_kind, bit_law)
     drive_state = np.array([float(axial_held), drive.axial_velocity, -hook_load, float(rotation_held),
                             drive.rotation_speed, k_p, k_i, drive.torque_limit, 0.0])
     return Simulation(string, float(dt), newmark_parameters(scene.time.newmark_alpha), constants, drive_state, state,
