@@ -851,6 +851,10 @@ def _check_relations(scene: Scene) -> Scene:
                          "not admissible with model.lateral_length = -1: the whole string carries its lateral fields "
                          "(set model.lateral_length to the length above the bit that needs them, or 0)")
     contact = scene.contact
+    if contact.normal_force == "dynamic" and scene.model.lateral_length < 0:
+        raise SceneError("contact.normal_force = 'dynamic' is not admissible with model.lateral_length = -1: it presses "
+                         "the wall where no lateral fields are solved, and the whole string carries them here (set "
+                         "model.lateral_length to the length above the bit that needs them, or 0)")
     if contact.static_friction >= 0:
         if contact.static_friction < contact.friction:
             raise SceneError(f"contact.static_friction = {contact.static_friction!r} is not admissible: must be >= "

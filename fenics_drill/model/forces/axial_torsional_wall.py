@@ -117,7 +117,8 @@ def _pressed_normals(u, turn, weight, axis, rigidity, lengths, out):
 
 def vertex_normal_forces(scene, x: np.ndarray) -> np.ndarray:
     """N_i [N] at vertices ``x`` (measured depths along the string): the soft string's wall force per length of the
-    scene's operation (module doc), integrated over the half elements beside each vertex."""
+    scene's operation at its drive's set points (module doc), integrated over the half elements beside each
+    vertex."""
     resolved = string_in_well(scene)  # the paper's straight horizontal hole without a survey
     sections, well = resolved.sections, resolved.well
     g = scene.environment.gravity if scene.model.gravity else 0.0
@@ -126,7 +127,9 @@ def vertex_normal_forces(scene, x: np.ndarray) -> np.ndarray:
     mesh = string_mesh(well, sections, min(scene.torque_drag.element_length, float(np.diff(x).min())),
                        weights, mu, mu)
     name = "rotating_on_bottom" if scene.starts_on_bottom else "rotating_off_bottom"
-    per_length = soft_string(mesh, operations(scene, [name])[0])["wall_force_per_length"]
+    # the run's own drive, not the set points a [torque_drag] section may give for its study
+    drive = scene.with_changes(torque_drag={"weight_on_bit": -1.0, "rotation_speed": -1.0, "rate_of_penetration": -1.0})
+    per_length = soft_string(mesh, operations(drive, [name])[0])["wall_force_per_length"]
     carried = np.concatenate([[0.0], np.cumsum(per_length * np.diff(mesh.md))])  # the wall's force above each node
     middle = np.concatenate([[x[0]], 0.5 * (x[1:] + x[:-1]), [x[-1]]])
     return np.diff(np.interp(middle, mesh.md, carried))
