@@ -59,7 +59,8 @@ class TensionPress:
     module doc): N_i = |P_i (T_i (a_i+ - a_i-) - W_i e_z)|, a_i- and a_i+ the axis' unit tangents (down-hole) over the
     elements above and below vertex i (its own at the ends), W_i the buoyed weight of its half elements, P_i the
     projection across its axis, and T_i the elements' mean axial forces E A (u_k+1 - u_k) / h_k beside it, weighted by
-    their lengths: the soft string's equilibrium across the axis (:mod:`~fenics_drill.model.soft_string`) at the vertex."""
+    their lengths: the soft string's equilibrium across the axis (:mod:`~fenics_drill.model.soft_string`) at the
+    vertex."""
 
     turn: np.ndarray  # (vertices, 3): a_i+ - a_i- [-]
     weight: np.ndarray  # (vertices,): W_i [N]
