@@ -356,8 +356,11 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
             if progress:  # the space it runs in and its length before it starts (the progress line's estimate follows)
                 space = "the full order" if model.space.sparse else "a reduced model"
                 why = f" ({summary['nominal_dt_reason']})" if capped else ""
-                sys.stderr.write(f"  {space}, {model.size} unknowns; {scene.time.t_end:g} s at a step of at most "
-                                 f"{summary['nominal_dt']:.3g} s{why}: at least {least_steps(scene):.0f} steps\n")
+                scope = summary["discretisation"].get("lateral")
+                split = f" ({scope['said']})" if scope else ""
+                sys.stderr.write(f"  {space}, {model.size} unknowns{split}; {scene.time.t_end:g} s at a step of at "
+                                 f"most {summary['nominal_dt']:.3g} s{why}: at least {least_steps(scene):.0f} "
+                                 "steps\n")
                 sys.stderr.flush()
             loop_clock = time.perf_counter()
             try:
@@ -396,11 +399,34 @@ def run_scene(scene, out: str | Path, progress: bool = True, overwrite: bool = F
 
 def _discretisation(model, scene) -> dict:
     """Which space the run took and why: the modal basis of ``reduction.rule``, or the full order (asked for, or
-    chosen by the 'auto' rule where no modal basis can be trusted)."""
+    chosen by the 'auto' rule where no modal basis can be trusted); where the lateral fields are not solved along the
+    whole string, what the run solves, what it leaves out and what 'auto' chose (:func:`lateral_scope`)."""
     full = model.space.sparse  # the full space's [Phi] is a sparse selection of the free dofs
     why = model.guard.get("full_order", {}).get("why") if full else None
+    scope = lateral_scope(scene)
     return {"space": "full order" if full else "modal", "unknowns": model.size, "rule": scene.reduction.rule,
-            **({"why": why} if why else {})}
+            **({"why": why} if why else {}), **({"lateral": scope} if scope else {})}
+
+
+def lateral_scope(scene) -> dict | None:
+    """``model.lateral_length``'s split as a run states it (None for the whole string's lateral fields): the length
+    whose lateral fields are solved [m], the elements' length above it [m] and who chose it, the wall's normal force
+    there, what the run leaves out above it, and a one-line ``said`` for the run's first line."""
+    lateral = scene.model.lateral_length
+    if lateral < 0:
+        return None
+    chosen = scene.axial_torsional_element_length
+    element = chosen if chosen > 0 else scene.string_length / scene.beam.elements
+    by = "auto" if scene.model.axial_torsional_element_length == 0 else "scene"
+    pressed = ("the string's own tension" if scene.contact.normal_force == "dynamic"
+               else "the soft string's normal force")
+    solved = f"lateral fields over the bottom {lateral:g} m" if lateral > 0 else "no lateral fields"
+    above = "above it" if lateral > 0 else "along the string"
+    return {"lateral_length_m": lateral, "axial_torsional_element_length_m": element, "element_length_by": by,
+            "wall_normal_force": scene.contact.normal_force,
+            "left_out": f"whirl, lateral shocks and bending {above}: u and theta_x alone on the well's axis",
+            "said": f"{solved}; u and theta_x {above} on {element:.3g} m elements ({by}), the wall pressed by "
+                    f"{pressed}"}
 
 
 def _check_disk_for_run(scene, out: Path) -> None:

@@ -184,6 +184,8 @@ def test_a_steadily_rotating_axial_torsional_string_on_bottom_carries_the_soft_s
     def means_of(scene):
         run = fd.run(scene)
         assert run.summary["status"] == "finished"
+        scope = run.summary["discretisation"]["lateral"]  # what the run solves and leaves out, stated
+        assert scope["lateral_length_m"] == 0.0 and scope["wall_normal_force"] == normal_force
         s = run.series
         t = s["time"].values
         late = t > 4.0
