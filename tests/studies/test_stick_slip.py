@@ -42,16 +42,18 @@ def test_the_band_solve_and_product_are_dense_algebra():
                                atol=1e-12 * np.abs(np.linalg.solve(dense, rhs)).max())
 
 
-def test_the_compiled_steps_follow_the_finite_element_models_run_of_the_same_string():
+@pytest.mark.parametrize("normal_force", ["static", "dynamic"])
+def test_the_compiled_steps_follow_the_finite_element_models_run_of_the_same_string(normal_force):
     """The 900 m build-and-hold demo well (90 elements), axial-torsional, drilling in stick-slip at 60 rpm under a
     hook-load drive with the cutting law: the compiled steps against ``fenics-drill run`` with
     ``model.lateral_length = 0`` (the same forms, wall law and bit law; adaptive Newmark steps there, fixed ones
     here).  Over the last 1.5 s of 3 s, the means of the surface torque and the weight on bit within 2 % (measured
     0.13 % and 0.08 %), the bit's fastest spin within 3 % of it (measured 0.3 %) and its stuck share within 0.05
     (measured 0.004):
-    two integrations of one stick-slip drift apart by their steps' errors."""
+    two integrations of one stick-slip drift apart by their steps' errors.  The same with the wall pressed by the
+    string's own tension (``contact.normal_force = 'dynamic'``; measured 0.11 %, 0.12 %, 0.4 % and 0.002)."""
     scene = fd.load_scene(BUILD_HOLD, ["beam.elements=90", "model.lateral_length=0.0", "time.t_end=3",
-                                       "output.field_interval=0"])
+                                       "output.field_interval=0", f"contact.normal_force='{normal_force}'"])
     compiled = start(scene).run(3.0)
     fe = fd.run(scene).series
     t_fe = fe["time"].values
