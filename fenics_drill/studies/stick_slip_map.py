@@ -234,11 +234,12 @@ def _assembled(scene, string, results: list[dict], seconds: float, ranks: int) -
                                        "weight_on_bit": ("weight_on_bit", weights, {"units": "N"}),
                                        "rotation_speed": ("rotation_speed", speeds, {"units": "rad/s"})},
                          attrs={"time_limit_s": m.time_limit, "drive_mode": scene.drive.mode,
-                                "bit_rock_law": scene.bit_rock.law})
+                                "bit_rock_law": scene.bit_rock.law, "wall_normal_force": scene.contact.normal_force})
     report = {"points": len(results), "ranks": ranks, "wall_time_s": seconds,
               "settled_points": int(sum(bool(r["settled"]) for r in results)),
               "failed_points": [i for i, r in enumerate(results) if r.get("failed")],
               "drive_mode": scene.drive.mode, "bit_rock_law": scene.bit_rock.law,
+              "wall_normal_force": scene.contact.normal_force,
               "controllers": {c: {"stick_slip_points": int(np.sum(field("stuck_share")[k] > 0.0)),
                                   "steady_points": int(np.sum(field("steady_rotation")[k] > 0.5))}
                               for k, c in enumerate(m.controllers)}}

@@ -219,6 +219,7 @@ def test_a_map_writes_its_table_and_figure(tmp_path, capsys):
     assert (out / "map.csv").read_text().splitlines()[0].startswith("controller,weight_on_bit (N),rotation_speed")
     assert (out / "stick_slip_map.png").exists()
     assert "stick-slip severity" in capsys.readouterr().out
+    assert grid.attrs["wall_normal_force"] == "static"  # how the wall was pressed, with the map
 
 
 @pytest.mark.parametrize("zeta, moved", [(0.0, True), (1.0, False)])
