@@ -96,6 +96,8 @@ def test_steady_rotation_on_bottom_carries_the_soft_strings_hook_load_and_torque
     assert means["surface_torque"] == pytest.approx(torque, rel=0.02)
     if pressed_for is not None:
         scene, held, (hook, torque) = steady_rotation_references(means_of, "static", pressed_for)
+        # the static wall pressed for 150 kN misses the torque of the 17 kN carried by 9.3 % (measured); above 5 %,
+        # well clear of the 2 % the dynamic wall is held to, so the case tells the two walls apart
         assert abs(held["surface_torque"] / torque - 1.0) > 0.05
 
 
