@@ -507,11 +507,14 @@ def hanging_tension(scene, md, weight_on_bit: float) -> np.ndarray:
         return np.full_like(md, -weight_on_bit)
     resolved = string_in_well(scene)
     sections, trajectory = resolved.sections, resolved.well.trajectory
-    fine = np.linspace(0.0, resolved.length, max(2001, 4 * scene.beam.elements + 1))
+    # intervals that break at every section end, so that each carries one section's weight: sampled across an end,
+    # a 2000-point grid put a step of 2 kN/m (8 in collars under 4 1/2 in pipe) up to 1.3 kN off
+    fine = np.union1d(np.linspace(0.0, resolved.length, max(2001, 4 * scene.beam.elements + 1)),
+                      [s.bottom for s in sections if 0.0 < s.bottom < resolved.length])
     weight = np.array([s.buoyed_weight(scene.environment.gravity, scene.fluid.density, scene.inner_fluid_density)
-                       for s in sections])[section_at(sections, fine)]
-    along = weight * np.cos(trajectory.inclination(fine))  # the weight's component down the axis [N/m]
-    below = np.concatenate([np.cumsum((0.5 * (along[1:] + along[:-1]) * np.diff(fine))[::-1])[::-1], [0.0]])
+                       for s in sections])[section_at(sections, 0.5 * (fine[1:] + fine[:-1]))]
+    axis = np.cos(trajectory.inclination(fine))  # the axis' share of a weight along it
+    below = np.concatenate([np.cumsum((weight * 0.5 * (axis[1:] + axis[:-1]) * np.diff(fine))[::-1])[::-1], [0.0]])
     return np.interp(md, fine, below) - weight_on_bit
 
 
