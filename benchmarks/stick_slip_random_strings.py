@@ -9,7 +9,7 @@ sizes, in air, drilling with the cutting law of Richard, Germay & Detournay (200
 hook-load drive at a weight on bit of 20-80 kN and a held rotation speed of 50-160 rpm.  Each is run on the map's
 default mesh and step (``stick_slip_map.element_length``, half the element's axial transit) and, as the reference, as
 the axial and torsional wave guides that meet in that law at the bit, solved along their characteristics on 1 m
-cells (tests/torsional_waves.py, :func:`axial_torsional_stick_slip`).  Statistics over [after, t_end]: the mean
+cells (tests/torsional_waves.py, :func:`hook_load_reference`).  Statistics over [after, t_end]: the mean
 cycle, the bit's fastest and slowest spin, the share of time stuck (below 1 % of the drive's speed), the mean surface
 torque; "bounces" where the reference's bit turns backwards (the irregular regime whose extremes move with the grid,
 docs/guide/stick_slip_maps.md).
@@ -18,7 +18,6 @@ docs/guide/stick_slip_maps.md).
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 import tempfile
 import time
@@ -31,7 +30,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from speed import machine, write_result  # noqa: E402
-from torsional_waves import _cutting_law, axial_torsional_stick_slip, limit_cycle_statistics  # noqa: E402
+from torsional_waves import hook_load_reference, limit_cycle_statistics  # noqa: E402
 
 import fenics_drill as fd  # noqa: E402
 from fenics_drill.model.axial_torsional_string import axial_torsional_string  # noqa: E402
@@ -105,24 +104,6 @@ def scene_of(case: dict, folder: Path):
     return map_scene(fd.load_scene(path))
 
 
-def reference(scene, duration: float, cell: float = 1.0) -> dict:
-    """The scene's string as the axial and torsional wave guides solved exactly on ``cell`` [m] torsional cells."""
-    beam = scene.beam
-    shear = beam.young_modulus / (2.0 * (1.0 + beam.poisson_ratio))
-    sections, weight = [], 0.0
-    for section in reversed(scene.string.sections):  # from the top down
-        outer, inner = section["outer_radius"], section["inner_radius"]
-        area, polar = math.pi * (outer**2 - inner**2), math.pi / 2.0 * (outer**4 - inner**4)
-        sections.append((section["length"], beam.young_modulus * area, beam.density * area, shear * polar,
-                         beam.density * polar))
-        weight += beam.density * area * section["length"] * scene.environment.gravity
-    drive = scene.drive
-    return axial_torsional_stick_slip(sections, drive.rotation_speed, drive.axial_velocity,
-                                      weight - drive.weight_on_bit, drive.weight_on_bit, beam.damping,
-                                      scene.environment.gravity, _cutting_law(scene.bit_rock), duration, cell,
-                                      max(1, round(10 / cell)))
-
-
 def cells(m: dict, series: dict, after: float) -> str:
     rop = np.mean(series["bit_velocity"][series["time"] > after]) * 3600.0
     return (f"{m['period']:.3f} | {m['max_spin']:.2f} | {m['min_spin']:.2f} | {m['stuck_share']:.3f} | "
@@ -151,7 +132,7 @@ def main() -> None:
                          time.perf_counter() - clock))
             for cell in CELLS:
                 clock = time.perf_counter()
-                runs.append((f"exact, {cell:g} m cells", reference(scene, args.t_end, cell),
+                runs.append((f"exact, {cell:g} m cells", hook_load_reference(scene, args.t_end, cell),
                              time.perf_counter() - clock))
                 exact = limit_cycle_statistics(runs[-1][1], omega, args.after)
                 regime = "bounces" if exact["min_spin"] < -0.01 * omega else (

@@ -437,7 +437,18 @@ def vertical_cutting_law_case(elements: int = 200, weight_on_bit: float = 60e3, 
         "beam.poisson_ratio=0.28", "fluid.density=0", f"beam.elements={elements}",
         f"drive.weight_on_bit={weight_on_bit}", f"drive.rotation_speed={rotation_speed}",
         f"bit_rock.backward_spin='{backward_spin}'"])
-    beam, bit = scene.beam, scene.bit_rock
+
+    def reference(duration: float, cell: float = 1.0) -> dict:
+        return hook_load_reference(scene, duration, cell)
+
+    return scene, reference
+
+
+def hook_load_reference(scene, duration: float, cell: float = 1.0) -> dict:
+    """:func:`axial_torsional_stick_slip` of a scene's string in air under its hook-load drive: its sections (from the
+    top down, St-Venant's round tubes, G = E / (2 (1 + nu))), the hook load its weight less the drive's weight on
+    bit, the drive's speeds, the scene's cutting law, ``cell`` [m] torsional cells."""
+    beam, drive = scene.beam, scene.drive
     shear = beam.young_modulus / (2.0 * (1.0 + beam.poisson_ratio))
     sections, weight = [], 0.0
     for section in reversed(scene.string.sections):
@@ -446,14 +457,10 @@ def vertical_cutting_law_case(elements: int = 200, weight_on_bit: float = 60e3, 
         sections.append((section["length"], beam.young_modulus * area, beam.density * area, shear * polar,
                          beam.density * polar))
         weight += beam.density * area * section["length"] * scene.environment.gravity
-    law = _cutting_law(bit)
-
-    def reference(duration: float, cell: float = 1.0) -> dict:
-        return axial_torsional_stick_slip(sections, rotation_speed, scene.drive.axial_velocity,
-                                          weight - weight_on_bit, weight_on_bit, beam.damping,
-                                          scene.environment.gravity, law, duration, cell, max(1, round(10 / cell)))
-
-    return scene, reference
+    return axial_torsional_stick_slip(sections, drive.rotation_speed, drive.axial_velocity,
+                                      weight - drive.weight_on_bit, drive.weight_on_bit, beam.damping,
+                                      scene.environment.gravity, _cutting_law(scene.bit_rock), duration, cell,
+                                      max(1, round(10 / cell)))
 
 
 #: Aarsnes & van de Wouw's published axial-torsional model (github.com/ulfjakob/AxialTorsionalDrillString, "Coupled -
