@@ -132,6 +132,8 @@ def test_the_limit_cycle_is_the_torsional_wave_guides_solved_along_its_character
     assert mine["period"] == pytest.approx(exact["period"], rel=0.005)
     assert mine["max_spin"] == pytest.approx(exact["max_spin"], rel=0.01)
     assert abs(mine["stuck_share"] - exact["stuck_share"]) < 0.01
+    # 1 %: four times the measured 0.25 % and five times the reference's own spread over its grids (0.2 %); a hook
+    # load 0.5 kN off (the sampled hook load this once had) puts the torque 1.6 % off and fails it
     assert mine["surface_torque"] == pytest.approx(exact["surface_torque"], rel=0.01)
 
 
@@ -152,6 +154,8 @@ def test_the_cutting_laws_limit_cycle_is_the_axial_and_torsional_wave_guides():
     exact = limit_cycle_statistics(reference(100.0), omega, 40.0)
     assert mine["cycles"] >= 12 and exact["stuck_share"] > 0.02
     assert mine["period"] == pytest.approx(exact["period"], rel=0.01)
+    # 1 %: four times the measured 0.25 % and five times the reference's own spread over its grids (0.2 %); a hook
+    # load 0.5 kN off (the sampled hook load this once had) puts the torque 1.6 % off and fails it
     assert mine["surface_torque"] == pytest.approx(exact["surface_torque"], rel=0.01)
     assert mine["max_spin"] == pytest.approx(exact["max_spin"], rel=0.08)
     assert abs(mine["stuck_share"] - exact["stuck_share"]) < 0.03
