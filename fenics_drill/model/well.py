@@ -508,7 +508,7 @@ def hanging_tension(scene, md, weight_on_bit: float) -> np.ndarray:
     resolved = string_in_well(scene)
     sections, trajectory = resolved.sections, resolved.well.trajectory
     # intervals that break at every section end, so that each carries one section's weight: sampled across an end,
-    # a 2000-point grid put 176 m of 8 in collars under 2416 m of 4 1/2 in pipe 700 N off (tests/model/test_wells.py)
+    # a 2000-point grid put 176 m of 8 in collars under 2416 m of 4 1/2 in pipe 659 N off (tests/model/test_wells.py)
     fine = np.union1d(np.linspace(0.0, resolved.length, max(2001, 4 * scene.beam.elements + 1)),
                       [s.bottom for s in sections if 0.0 < s.bottom < resolved.length])
     weight = np.array([s.buoyed_weight(scene.environment.gravity, scene.fluid.density, scene.inner_fluid_density)
